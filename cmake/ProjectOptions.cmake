@@ -1,0 +1,26 @@
+# SPDX-License-Identifier: Apache-2.0
+# Warnings and sanitizer settings shared by every target of the project.
+
+add_library(tensegrity_warnings INTERFACE)
+add_library(tensegrity::warnings ALIAS tensegrity_warnings)
+target_compile_options(tensegrity_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow
+  -Wnon-virtual-dtor -Wconversion -Wno-sign-conversion)
+
+option(TENSEGRITY_WERROR "Treat warnings as errors" ON)
+if(TENSEGRITY_WERROR)
+  target_compile_options(tensegrity_warnings INTERFACE -Werror)
+endif()
+
+option(TENSEGRITY_SANITIZE "Build with AddressSanitizer and UndefinedBehaviorSanitizer" OFF)
+if(TENSEGRITY_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+# Every project library/executable: warnings on, the repository root as include
+# root so that an include line names the room it reaches into
+# (#include "firmware/core/motor_loop.hpp").
+function(tensegrity_target_defaults target)
+  target_link_libraries(${target} PRIVATE tensegrity::warnings)
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
+endfunction()

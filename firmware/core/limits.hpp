@@ -1,0 +1,22 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Fixed capacities and per-motor limits of the control core. The core has no heap
+// after construction, so every table it holds has a compile-time bound.
+#include <cstddef>
+
+namespace tensegrity::core {
+
+inline constexpr std::size_t kMaxMotorsPerEndcap = 4;
+inline constexpr std::size_t kMaxComplexity = 16;
+
+struct MotorLimits {
+  double min_rest_length_m = 0.6;
+  double max_rest_length_m = 1.1;
+  double speed_m_per_s = 0.2;
+  // Above this the motor stops shortening (it may still pay out cable).
+  double cutoff_tension_n = 400.0;
+  // Above this the end cap faults and holds until the fault is cleared.
+  double hard_limit_tension_n = 500.0;
+};
+
+}  // namespace tensegrity::core
