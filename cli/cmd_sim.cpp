@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity sim`: one episode, a readable summary or one JSON object.
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "cli/commands.hpp"
+#include "cli/episode_json.hpp"
+#include "sim/benchmark_policy.hpp"
+#include "sim/episode.hpp"
+
+namespace tensegrity::cli {
+namespace {
+
+struct SimArgs {
+  std::string robot;
+  std::string policy;
+  bool benchmark_policy = false;
+  double duration_s = 60.0;
+  double dt_s = 0.0;
+  std::string telemetry;
+  int telemetry_every = 1;
+  std::string start = "settled";
+  bool start_given = false;
+  bool json = false;
+};
+
+void run_sim(const SimArgs& args) {
+  const sim::Robot robot = load_robot_arg(args.robot);
+  std::unique_ptr<sim::Controller> controller;
+  std::string controller_name;
+  sim::EpisodeOptions options;
+  options.duration_s = args.duration_s;
+  options.dt_s = args.dt_s;
+  if (!args.policy.empty()) {
+    controller = make_policy_controller(robot, args.policy);
+    controller_name = args.policy;
+  } else {
+    controller = std::make_unique<sim::BenchmarkController>();
+    controller_name = "benchmark policy";
+  }
+  options.start = args.start == "drop" ? sim::StartKind::drop : sim::StartKind::settled;
+  // The benchmark's defined start, unless the user chose one.
+  if (args.policy.empty() && !args.start_given) options.start = sim::StartKind::drop;
+  std::unique_ptr<sim::CsvTelemetry> telemetry;
+  if (!args.telemetry.empty()) {
+    telemetry = std::make_unique<sim::CsvTelemetry>(args.telemetry);
+    options.telemetry = telemetry.get();
+    options.telemetry_every = args.telemetry_every;
+  }
+  const sim::EpisodeResult result = sim::run_episode(robot, *controller, options);
+  if (args.json) {
+    nlohmann::json j = episode_json(result);
+    j["robot"] = robot.name;
+    j["robot_hash"] = robot.hash;
+    j["controller"] = controller_name;
+    j["dt_s"] = options.dt_s > 0 ? options.dt_s : robot.time_step_s;
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("robot %s (%s), %s, %.1f s at dt %.4g s, %s start\n", robot.name.c_str(),
+                robot.hash.c_str(), controller_name.c_str(), args.duration_s,
+                options.dt_s > 0 ? options.dt_s : robot.time_step_s,
+                options.start == sim::StartKind::drop ? "drop" : "settled");
+    print_episode_summary(result);
+  }
+}
+
+}  // namespace
+
+void add_sim_command(CLI::App& app) {
+  auto args = std::make_shared<SimArgs>();
+  CLI::App* cmd = app.add_subcommand("sim", "Run one episode of the robot model and summarise it");
+  cmd->add_option("--robot", args->robot, "Robot description (default: robots/superball.json)")
+      ->check(CLI::ExistingFile);
+  auto* policy = cmd->add_option("--policy", args->policy, "Policy file to play (tensegrity-policy/1)")
+                     ->check(CLI::ExistingFile);
+  cmd->add_flag("--benchmark-policy", args->benchmark_policy,
+                "Play the fixed benchmark policy (the default without --policy)")
+      ->excludes(policy);
+  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  cmd->add_option("--dt", args->dt_s, "Time step, seconds (default: the robot's)")
+      ->check(CLI::Range(1e-5, 0.01));
+  auto* start = cmd->add_option("--start", args->start,
+                                "Start: settled (at rest on the ground; default with --policy) or drop "
+                                "(the benchmark's start; default without)")
+                    ->check(CLI::IsMember({"settled", "drop"}));
+  cmd->add_option("--telemetry", args->telemetry, "Write per-step telemetry to this CSV file");
+  cmd->add_option("--telemetry-every", args->telemetry_every, "Record every N-th step")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--json", args->json, "Print one JSON object instead of the summary");
+  cmd->callback([args, start] {
+    args->start_given = start->count() > 0;
+    run_sim(*args);
+  });
+}
+
+}  // namespace tensegrity::cli

@@ -1,0 +1,23 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Each `tensegrity` subcommand adds itself to the app and runs from its callback.
+// A callback reports failure by throwing CommandError (exit code and message).
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+
+namespace tensegrity::cli {
+
+class CommandError : public std::runtime_error {
+ public:
+  CommandError(int exit_code, const std::string& message)
+      : std::runtime_error(message), exit_code_(exit_code) {}
+  int exit_code() const { return exit_code_; }
+
+ private:
+  int exit_code_;
+};
+
+void add_sim_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+
+}  // namespace tensegrity::cli

@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "cli/episode_json.hpp"
+
+#include <cstdio>
+
+#include "sim/core_controller.hpp"
+#include "sim/policy.hpp"
+
+namespace tensegrity::cli {
+
+sim::Robot load_robot_arg(const std::string& path) {
+  return sim::load_robot(path.empty() ? sim::default_robot_path() : std::filesystem::path(path));
+}
+
+nlohmann::json episode_json(const sim::EpisodeResult& r) {
+  return {
+      {"distance_m", r.distance_m},
+      {"displacement_m", {r.displacement_m.x(), r.displacement_m.y()}},
+      {"feasible", r.feasible},
+      {"infeasible_reason", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_reason)},
+      {"infeasible_time_s", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_time_s)},
+      {"max_tension_n", r.max_tension_n},
+      {"mean_tension_n", r.mean_tension_n},
+      {"motor_energy_j", r.motor_energy_j},
+      {"mean_motor_power_w", r.mean_motor_power_w},
+      {"steps", r.steps},
+      {"sim_time_s", r.sim_time_s},
+      {"wall_time_s", r.wall_time_s},
+      {"real_time_factor", r.real_time_factor()},
+  };
+}
+
+void print_episode_summary(const sim::EpisodeResult& r) {
+  if (r.feasible) {
+    std::printf("  distance       %8.3f m  (dx %.3f, dy %.3f)\n", r.distance_m, r.displacement_m.x(),
+                r.displacement_m.y());
+  } else {
+    std::printf("  INFEASIBLE at t = %.3f s: %s\n", r.infeasible_time_s, r.infeasible_reason.c_str());
+  }
+  std::printf("  tension        mean %.1f N, max %.1f N\n", r.mean_tension_n, r.max_tension_n);
+  std::printf("  motors         %.1f J, %.2f W per cable on average\n", r.motor_energy_j, r.mean_motor_power_w);
+  std::printf("  time           %.2f s simulated in %.3f s wall (%.0fx real time)\n", r.sim_time_s,
+              r.wall_time_s, r.real_time_factor());
+}
+
+std::unique_ptr<sim::Controller> make_policy_controller(const sim::Robot& robot, const std::string& path) {
+  const sim::Policy policy = sim::load_policy(path, robot);
+  return std::make_unique<sim::CoreController>(robot, policy);
+}
+
+}  // namespace tensegrity::cli

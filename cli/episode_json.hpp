@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Shared by the subcommands that run episodes: result as JSON or readable text, and
+// the controller a policy file plays through.
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "sim/controller.hpp"
+#include "sim/episode.hpp"
+
+namespace tensegrity::cli {
+
+// The robot of a --robot option; the shipped default when empty.
+sim::Robot load_robot_arg(const std::string& path);
+nlohmann::json episode_json(const sim::EpisodeResult& result);
+void print_episode_summary(const sim::EpisodeResult& result);
+std::unique_ptr<sim::Controller> make_policy_controller(const sim::Robot& robot, const std::string& path);
+
+}  // namespace tensegrity::cli

@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity`: the host program (simulate, benchmark, evolve, upload, HIL, ...).
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"tensegrity: SUPERball simulator, coevolution and ground tools"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "tensegrity 0.1.0");
+  tensegrity::cli::add_sim_command(app);
+  tensegrity::cli::add_bench_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const tensegrity::cli::CommandError& e) {
+    std::fprintf(stderr, "tensegrity: %s\n", e.what());
+    return e.exit_code();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tensegrity: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

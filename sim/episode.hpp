@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// One episode: a robot, a controller, a duration, a start; the distance its centre
+// travels, whether it stayed feasible, and summary figures.
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+
+#include "sim/controller.hpp"
+#include "sim/model.hpp"
+#include "sim/robot.hpp"
+#include "sim/telemetry.hpp"
+
+namespace tensegrity::sim {
+
+enum class StartKind {
+  settled,  // dropped, then left to settle for the robot's settle_s: "from rest"
+  drop,     // the description's pose, lowest end cap clearance_m above the ground
+};
+
+struct EpisodeOptions {
+  double duration_s = 60.0;
+  double dt_s = 0.0;  // 0: the robot's time step
+  StartKind start = StartKind::settled;
+  const ModelState* start_state = nullptr;  // a given pose; overrides `start`
+  TelemetrySink* telemetry = nullptr;
+  int telemetry_every = 1;  // record every N-th step
+};
+
+struct EpisodeResult {
+  double distance_m = 0.0;  // horizontal, centre of the end caps, final minus initial
+  Eigen::Vector2d displacement_m = Eigen::Vector2d::Zero();
+  bool feasible = true;
+  std::string infeasible_reason;
+  double infeasible_time_s = 0.0;
+  double max_tension_n = 0.0;
+  double mean_tension_n = 0.0;   // over time and cables
+  double motor_energy_j = 0.0;   // work the motors did shortening cables under tension
+  double mean_motor_power_w = 0.0;  // per cable
+  double sim_time_s = 0.0;
+  double wall_time_s = 0.0;
+  std::int64_t steps = 0;
+  double real_time_factor() const { return wall_time_s > 0.0 ? sim_time_s / wall_time_s : 0.0; }
+};
+
+// The description's node pose, shifted so the lowest end cap's surface is
+// clearance_m above the ground.
+ModelState drop_state(const Robot& robot, double dt_s);
+// Dropped and settled for settle_s with every rest length at its initial value.
+// Computed once per robot and time step, then shared (thread-safe).
+const ModelState& settled_state(const Robot& robot, double dt_s);
+
+EpisodeResult run_episode(const Robot& robot, Controller& controller, const EpisodeOptions& options);
+
+}  // namespace tensegrity::sim

@@ -1,0 +1,321 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "sim/model.hpp"
+
+#include <ode/ode.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <mutex>
+
+#include "firmware/core/rate_limit.hpp"
+
+namespace tensegrity::sim {
+namespace {
+
+void init_ode_for_this_thread() {
+  static std::once_flag once;
+  std::call_once(once, [] { dInitODE2(0); });
+  thread_local const bool allocated = [] {
+    dAllocateODEDataForThread(dAllocateMaskAll);
+    return true;
+  }();
+  (void)allocated;
+}
+
+Eigen::Vector3d vec(const dReal* v) { return {v[0], v[1], v[2]}; }
+// ODE keeps rotations as 3x4 row-major matrices; column 2 is the body z axis, which
+// is the strut's axis here.
+Eigen::Vector3d axis_of(const dReal* R) { return {R[2], R[6], R[10]}; }
+
+}  // namespace
+
+struct Model::Ode {
+  dWorldID world = nullptr;
+  dJointGroupID contacts = nullptr;
+  std::vector<dBodyID> bodies;
+  std::vector<Eigen::Vector3d> inertia_diag;  // body frame, kg m^2
+  ~Ode() {
+    if (contacts != nullptr) dJointGroupDestroy(contacts);
+    if (world != nullptr) dWorldDestroy(world);
+  }
+};
+
+Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_(std::make_unique<Ode>()) {
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
+  init_ode_for_this_thread();
+  ode_->world = dWorldCreate();
+  ode_->contacts = dJointGroupCreate(0);
+  dWorldSetAutoDisableFlag(ode_->world, 0);
+  set_gravity_enabled(true);
+
+  const int nodes = robot_.node_count();
+  strut_of_node_.assign(nodes, -1);
+  end_sign_of_node_.assign(nodes, 0.0);
+  for (std::size_t s = 0; s < robot_.struts.size(); ++s) {
+    const auto& strut = robot_.struts[s];
+    const double length = (robot_.nodes_m[strut.node_b] - robot_.nodes_m[strut.node_a]).norm();
+    half_length_m_.push_back(0.5 * length);
+    strut_of_node_[strut.node_a] = static_cast<int>(s);
+    strut_of_node_[strut.node_b] = static_cast<int>(s);
+    end_sign_of_node_[strut.node_a] = -1.0;
+    end_sign_of_node_[strut.node_b] = +1.0;
+
+    dBodyID body = dBodyCreate(ode_->world);
+    dMass mass;
+    // A capsule whose end spheres are centred on the end caps.
+    dMassSetCapsuleTotal(&mass, robot_.strut_mass_kg, 3, robot_.strut_radius_m, length);
+    dBodySetMass(body, &mass);
+    ode_->bodies.push_back(body);
+    ode_->inertia_diag.emplace_back(mass.I[0], mass.I[5], mass.I[10]);
+  }
+  const auto cables = static_cast<std::size_t>(robot_.cable_count());
+  rest_length_m_.assign(cables, robot_.initial_rest_length_m);
+  length_m_.assign(cables, 0.0);
+  length_rate_m_per_s_.assign(cables, 0.0);
+  tension_n_.assign(cables, 0.0);
+  rest_rate_m_per_s_.assign(cables, 0.0);
+  node_pos_.assign(nodes, Eigen::Vector3d::Zero());
+  node_vel_.assign(nodes, Eigen::Vector3d::Zero());
+  force_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
+  torque_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
+  place(robot_.nodes_m);
+}
+
+Model::~Model() = default;
+
+void Model::set_gravity_enabled(bool on) {
+  dWorldSetGravity(ode_->world, 0, 0, on ? -robot_.gravity_m_per_s2 : 0.0);
+}
+
+void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
+  for (std::size_t s = 0; s < robot_.struts.size(); ++s) {
+    const Eigen::Vector3d a = nodes_m[robot_.struts[s].node_a];
+    const Eigen::Vector3d b = nodes_m[robot_.struts[s].node_b];
+    const Eigen::Vector3d centre = 0.5 * (a + b);
+    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a);
+    dBodyID body = ode_->bodies[s];
+    dBodySetPosition(body, centre.x(), centre.y(), centre.z());
+    const dQuaternion dq = {q.w(), q.x(), q.y(), q.z()};
+    dBodySetQuaternion(body, dq);
+    dBodySetLinearVel(body, 0, 0, 0);
+    dBodySetAngularVel(body, 0, 0, 0);
+  }
+  std::fill(rest_length_m_.begin(), rest_length_m_.end(), robot_.initial_rest_length_m);
+  std::fill(rest_rate_m_per_s_.begin(), rest_rate_m_per_s_.end(), 0.0);
+  update_cable_geometry();
+  std::fill(tension_n_.begin(), tension_n_.end(), 0.0);
+}
+
+ModelState Model::save() const {
+  ModelState state;
+  for (dBodyID body : ode_->bodies) {
+    const dReal* p = dBodyGetPosition(body);
+    const dReal* q = dBodyGetQuaternion(body);
+    const dReal* v = dBodyGetLinearVel(body);
+    const dReal* w = dBodyGetAngularVel(body);
+    state.body.insert(state.body.end(), {p[0], p[1], p[2], q[0], q[1], q[2], q[3], v[0], v[1],
+                                         v[2], w[0], w[1], w[2]});
+  }
+  state.rest_length_m = rest_length_m_;
+  state.tension_n = tension_n_;
+  return state;
+}
+
+void Model::restore(const ModelState& state) {
+  if (state.body.size() != ode_->bodies.size() * 13 ||
+      state.rest_length_m.size() != rest_length_m_.size()) {
+    throw RobotError("model: snapshot does not match this robot");
+  }
+  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+    const double* b = &state.body[s * 13];
+    dBodyID body = ode_->bodies[s];
+    dBodySetPosition(body, b[0], b[1], b[2]);
+    const dQuaternion q = {b[3], b[4], b[5], b[6]};
+    dBodySetQuaternion(body, q);
+    dBodySetLinearVel(body, b[7], b[8], b[9]);
+    dBodySetAngularVel(body, b[10], b[11], b[12]);
+  }
+  rest_length_m_ = state.rest_length_m;
+  tension_n_ = state.tension_n;
+  std::fill(rest_rate_m_per_s_.begin(), rest_rate_m_per_s_.end(), 0.0);
+  update_cable_geometry();
+}
+
+void Model::update_cable_geometry() {
+  for (std::size_t node = 0; node < node_pos_.size(); ++node) {
+    const int s = strut_of_node_[node];
+    dBodyID body = ode_->bodies[s];
+    const Eigen::Vector3d r = (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
+    node_pos_[node] = vec(dBodyGetPosition(body)) + r;
+    node_vel_[node] = vec(dBodyGetLinearVel(body)) + vec(dBodyGetAngularVel(body)).cross(r);
+  }
+  for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
+    const auto& cable = robot_.cables[m];
+    const Eigen::Vector3d d = node_pos_[cable.node_b] - node_pos_[cable.node_a];
+    const double length = d.norm();
+    length_m_[m] = length;
+    length_rate_m_per_s_[m] =
+        length > 0.0 ? (node_vel_[cable.node_b] - node_vel_[cable.node_a]).dot(d) / length : 0.0;
+  }
+}
+
+void Model::apply_forces() {
+  for (auto& f : force_) f.setZero();
+  for (auto& t : torque_) t.setZero();
+  for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
+    const auto& cable = robot_.cables[m];
+    const double stretch = length_m_[m] - rest_length_m_[m];
+    double tension = 0.0;
+    // One-sided: a slack cable pushes nothing, and its damper cannot pull it taut.
+    if (stretch > 0.0) {
+      tension = cable.stiffness_n_per_m * stretch;
+      if (damping_enabled_) tension += cable.damping_n_s_per_m * length_rate_m_per_s_[m];
+      if (tension < 0.0) tension = 0.0;
+    }
+    tension_n_[m] = tension;
+    if (tension == 0.0) continue;
+    const Eigen::Vector3d u = (node_pos_[cable.node_b] - node_pos_[cable.node_a]) / length_m_[m];
+    const Eigen::Vector3d f = tension * u;  // pulls node a toward b, b toward a
+    for (const auto& [node, force] : {std::pair{cable.node_a, f}, std::pair{cable.node_b, Eigen::Vector3d(-f)}}) {
+      const int s = strut_of_node_[node];
+      const Eigen::Vector3d r = node_pos_[node] - vec(dBodyGetPosition(ode_->bodies[s]));
+      force_[s] += force;
+      torque_[s] += r.cross(force);
+    }
+  }
+  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+    dBodyID body = ode_->bodies[s];
+    if (damping_enabled_ && robot_.axial_damping_n_m_s > 0.0) {
+      const Eigen::Vector3d axis = axis_of(dBodyGetRotation(body));
+      const double spin = vec(dBodyGetAngularVel(body)).dot(axis);
+      torque_[s] -= (robot_.axial_damping_n_m_s * spin) * axis;
+    }
+    dBodyAddForce(body, force_[s].x(), force_[s].y(), force_[s].z());
+    dBodyAddTorque(body, torque_[s].x(), torque_[s].y(), torque_[s].z());
+  }
+}
+
+void Model::add_ground_contacts() {
+  contact_count_ = 0;
+  if (!ground_enabled_) return;
+  // A capsule meets a plane only with its end spheres, so two sphere tests per strut
+  // replace ODE's broad phase (which is also not thread-safe in Debian's build).
+  const double r = robot_.strut_radius_m;
+  const double kp = robot_.contact_stiffness_n_per_m;
+  const double kd = robot_.contact_damping_n_s_per_m;
+  const double h = dt_s_;
+  dContact contact{};
+  contact.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
+  if (robot_.ground_restitution > 0.0) {
+    contact.surface.mode |= dContactBounce;
+    contact.surface.bounce = robot_.ground_restitution;
+  }
+  contact.surface.mu = robot_.ground_friction;
+  contact.surface.soft_erp = h * kp / (h * kp + kd);
+  contact.surface.soft_cfm = 1.0 / (h * kp + kd);
+  contact.geom.normal[0] = 0;
+  contact.geom.normal[1] = 0;
+  contact.geom.normal[2] = 1;
+  for (std::size_t node = 0; node < node_pos_.size(); ++node) {
+    const double depth = r - node_pos_[node].z();
+    if (depth <= 0.0) continue;
+    contact.geom.pos[0] = node_pos_[node].x();
+    contact.geom.pos[1] = node_pos_[node].y();
+    contact.geom.pos[2] = node_pos_[node].z() - r;
+    contact.geom.depth = depth;
+    dJointID joint = dJointCreateContact(ode_->world, ode_->contacts, &contact);
+    dJointAttach(joint, ode_->bodies[strut_of_node_[node]], nullptr);
+    ++contact_count_;
+  }
+}
+
+void Model::step(std::span<const double> preferred_rest_length_m) {
+  const auto& limits = robot_.motor;
+  const double max_step = limits.speed_m_per_s * dt_s_;
+  for (std::size_t m = 0; m < rest_length_m_.size(); ++m) {
+    const double target =
+        core::clamp_to(preferred_rest_length_m[m], limits.min_rest_length_m, limits.max_rest_length_m);
+    const double next = core::move_toward(rest_length_m_[m], target, max_step);
+    rest_rate_m_per_s_[m] = (next - rest_length_m_[m]) / dt_s_;
+    rest_length_m_[m] = next;
+  }
+  update_cable_geometry();
+  apply_forces();
+  add_ground_contacts();
+  dWorldStep(ode_->world, dt_s_);
+  dJointGroupEmpty(ode_->contacts);
+}
+
+Eigen::Vector3d Model::node_position(int node) const {
+  const int s = strut_of_node_[node];
+  dBodyID body = ode_->bodies[s];
+  return vec(dBodyGetPosition(body)) +
+         (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
+}
+
+std::vector<Eigen::Vector3d> Model::node_positions() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(node_pos_.size());
+  for (int i = 0; i < robot_.node_count(); ++i) out.push_back(node_position(i));
+  return out;
+}
+
+Eigen::Vector3d Model::centre_m() const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int i = 0; i < robot_.node_count(); ++i) sum += node_position(i);
+  return sum / robot_.node_count();
+}
+
+double Model::kinetic_energy_j() const {
+  double e = 0.0;
+  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+    dBodyID body = ode_->bodies[s];
+    const Eigen::Vector3d v = vec(dBodyGetLinearVel(body));
+    dVector3 wb;
+    const dReal* w = dBodyGetAngularVel(body);
+    dBodyVectorFromWorld(body, w[0], w[1], w[2], wb);
+    const Eigen::Vector3d& I = ode_->inertia_diag[s];
+    e += 0.5 * robot_.strut_mass_kg * v.squaredNorm() +
+         0.5 * (I.x() * wb[0] * wb[0] + I.y() * wb[1] * wb[1] + I.z() * wb[2] * wb[2]);
+  }
+  return e;
+}
+
+double Model::gravity_energy_j() const {
+  double e = 0.0;
+  for (dBodyID body : ode_->bodies) e += robot_.strut_mass_kg * robot_.gravity_m_per_s2 * dBodyGetPosition(body)[2];
+  return e;
+}
+
+double Model::elastic_energy_j() const {
+  double e = 0.0;
+  for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
+    const Eigen::Vector3d d = node_position(robot_.cables[m].node_b) - node_position(robot_.cables[m].node_a);
+    const double stretch = d.norm() - rest_length_m_[m];
+    if (stretch > 0.0) e += 0.5 * robot_.cables[m].stiffness_n_per_m * stretch * stretch;
+  }
+  return e;
+}
+
+double Model::axial_spin_rad_per_s(int strut) const {
+  dBodyID body = ode_->bodies[strut];
+  return vec(dBodyGetAngularVel(body)).dot(axis_of(dBodyGetRotation(body)));
+}
+
+void Model::set_velocity(int strut, const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+  dBodySetLinearVel(ode_->bodies[strut], v.x(), v.y(), v.z());
+  dBodySetAngularVel(ode_->bodies[strut], w.x(), w.y(), w.z());
+}
+
+bool Model::state_finite() const {
+  double sum = 0.0;
+  for (dBodyID body : ode_->bodies) {
+    const dReal* p = dBodyGetPosition(body);
+    const dReal* v = dBodyGetLinearVel(body);
+    const dReal* w = dBodyGetAngularVel(body);
+    sum += p[0] + p[1] + p[2] + v[0] + v[1] + v[2] + w[0] + w[1] + w[2];
+  }
+  return std::isfinite(sum);
+}
+
+}  // namespace tensegrity::sim

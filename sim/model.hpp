@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The robot in ODE: struts as capsule bodies, cables as one-sided spring-dampers
+// between strut end points whose rest lengths motors drive, a ground plane.
+#include <Eigen/Core>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "sim/robot.hpp"
+
+namespace tensegrity::sim {
+
+// Full dynamic state, enough to restart a run bit-identically from a snapshot.
+struct ModelState {
+  std::vector<double> body;           // per strut: pos(3) quat(4) linvel(3) angvel(3)
+  std::vector<double> rest_length_m;  // per cable
+  std::vector<double> tension_n;      // per cable, last computed
+};
+
+class Model {
+ public:
+  Model(const Robot& robot, double dt_s);
+  ~Model();
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  // Places the struts so that their end caps sit at `nodes_m`, at rest, every rest
+  // length at the robot's initial value.
+  void place(std::span<const Eigen::Vector3d> nodes_m);
+  ModelState save() const;
+  void restore(const ModelState& state);
+
+  // One time step: rest lengths move toward `preferred_rest_length_m` at the motor
+  // speed (clamped to the limits), cable forces and ground contacts are applied,
+  // the world advances by dt.
+  void step(std::span<const double> preferred_rest_length_m);
+
+  double dt_s() const { return dt_s_; }
+  const Robot& robot() const { return robot_; }
+  int cable_count() const { return robot_.cable_count(); }
+
+  // Per cable, as used in the last step (or after place/restore).
+  std::span<const double> rest_length_m() const { return rest_length_m_; }
+  std::span<const double> length_m() const { return length_m_; }
+  std::span<const double> tension_n() const { return tension_n_; }
+  std::span<const double> rest_length_rate_m_per_s() const { return rest_rate_m_per_s_; }
+
+  Eigen::Vector3d node_position(int node) const;
+  std::vector<Eigen::Vector3d> node_positions() const;
+  Eigen::Vector3d centre_m() const;  // mean of the end caps
+  double kinetic_energy_j() const;
+  double gravity_energy_j() const;  // relative to z = 0
+  double elastic_energy_j() const;
+  // Strut spin about its own axis, rad/s.
+  double axial_spin_rad_per_s(int strut) const;
+  void set_velocity(int strut, const Eigen::Vector3d& linear_m_per_s,
+                    const Eigen::Vector3d& angular_rad_per_s);
+  bool state_finite() const;
+  int contact_count() const { return contact_count_; }
+
+  // Switches for the energy-conservation test; defaults follow the robot.
+  void set_gravity_enabled(bool on);
+  void set_ground_enabled(bool on) { ground_enabled_ = on; }
+  void set_damping_enabled(bool on) { damping_enabled_ = on; }
+
+ private:
+  struct Ode;
+  void update_cable_geometry();
+  void apply_forces();
+  void add_ground_contacts();
+
+  Robot robot_;
+  double dt_s_;
+  std::unique_ptr<Ode> ode_;
+  // Per strut: half length, and per node the strut and the sign of its end.
+  std::vector<double> half_length_m_;
+  std::vector<int> strut_of_node_;
+  std::vector<double> end_sign_of_node_;
+  std::vector<double> rest_length_m_, length_m_, length_rate_m_per_s_, tension_n_,
+      rest_rate_m_per_s_;
+  std::vector<Eigen::Vector3d> node_pos_, node_vel_, force_, torque_;
+  bool ground_enabled_ = true;
+  bool damping_enabled_ = true;
+  int contact_count_ = 0;
+};
+
+}  // namespace tensegrity::sim

@@ -1,0 +1,177 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "sim/policy.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace tensegrity::sim {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& message) {
+  throw PolicyError(source + ": " + field + ": " + message);
+}
+
+const json& need(const json& j, const std::string& key, const std::string& source, const std::string& path) {
+  if (!j.is_object()) fail(source, path.empty() ? "(top)" : path, "must be an object");
+  const auto it = j.find(key);
+  if (it == j.end()) fail(source, path.empty() ? key : path + "." + key, "missing");
+  return *it;
+}
+
+double finite_number(const json& v, const std::string& source, const std::string& field) {
+  if (!v.is_number()) fail(source, field, "must be a number");
+  const double x = v.get<double>();
+  if (!std::isfinite(x)) fail(source, field, "must be finite");
+  return x;
+}
+
+long long integer(const json& v, const std::string& source, const std::string& field) {
+  if (!v.is_number_integer()) fail(source, field, "must be an integer");
+  return v.get<long long>();
+}
+
+}  // namespace
+
+Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source) {
+  json doc;
+  try {
+    doc = json::parse(json_text);
+  } catch (const json::parse_error& e) {
+    throw PolicyError(source + ": not valid JSON: " + e.what());
+  }
+  Policy policy;
+  const json& format = need(doc, "format", source, "");
+  if (!format.is_string() || format.get<std::string>() != "tensegrity-policy/1") {
+    fail(source, "format", "expected \"tensegrity-policy/1\"");
+  }
+  const json& name = need(doc, "robot", source, "");
+  if (!name.is_string()) fail(source, "robot", "must be a string");
+  policy.robot = name.get<std::string>();
+  if (policy.robot != robot.name) {
+    fail(source, "robot", "policy is for robot \"" + policy.robot + "\", not \"" + robot.name + "\"");
+  }
+  policy.period_s = finite_number(need(doc, "period_s", source, ""), source, "period_s");
+  if (!(policy.period_s > 0.0) || policy.period_s > 3600.0) fail(source, "period_s", "must be within (0, 3600] s");
+  const long long complexity = integer(need(doc, "complexity", source, ""), source, "complexity");
+  if (complexity < 1 || complexity > static_cast<long long>(core::kMaxComplexity)) {
+    fail(source, "complexity", "must be 1.." + std::to_string(core::kMaxComplexity));
+  }
+  policy.complexity = static_cast<int>(complexity);
+
+  const json& cables = need(doc, "cables", source, "");
+  if (!cables.is_array()) fail(source, "cables", "must be an array");
+  if (static_cast<int>(cables.size()) != robot.cable_count()) {
+    fail(source, "cables", "has " + std::to_string(cables.size()) + " entries, the robot has " +
+                               std::to_string(robot.cable_count()) + " cables");
+  }
+  policy.cables.resize(cables.size());
+  std::vector<bool> seen(cables.size(), false);
+  for (std::size_t i = 0; i < cables.size(); ++i) {
+    const std::string path = "cables[" + std::to_string(i) + "]";
+    const json& entry = cables[i];
+    const long long index = integer(need(entry, "cable", source, path), source, path + ".cable");
+    if (index < 0 || index >= robot.cable_count()) fail(source, path + ".cable", "no such cable");
+    if (seen[index]) fail(source, path + ".cable", "cable " + std::to_string(index) + " appears twice");
+    seen[index] = true;
+    CablePolicy& cable = policy.cables[index];
+    cable.cable = static_cast<int>(index);
+    const long long owner = integer(need(entry, "owner", source, path), source, path + ".owner");
+    if (owner != robot.cables[index].owner) {
+      fail(source, path + ".owner", "cable " + std::to_string(index) + " is owned by end cap " +
+                                        std::to_string(robot.cables[index].owner) + ", not " +
+                                        std::to_string(owner));
+    }
+    cable.owner = static_cast<int>(owner);
+    const json& values = need(entry, "rest_lengths_m", source, path);
+    if (!values.is_array() || static_cast<long long>(values.size()) != complexity) {
+      fail(source, path + ".rest_lengths_m", "must hold exactly " + std::to_string(complexity) + " values");
+    }
+    for (std::size_t j = 0; j < values.size(); ++j) {
+      const std::string field = path + ".rest_lengths_m[" + std::to_string(j) + "]";
+      const double v = finite_number(values[j], source, field);
+      if (v < robot.motor.min_rest_length_m || v > robot.motor.max_rest_length_m) {
+        std::ostringstream msg;
+        msg << v << " m is outside the rest-length limits [" << robot.motor.min_rest_length_m << ", "
+            << robot.motor.max_rest_length_m << "] m";
+        fail(source, field, msg.str());
+      }
+      cable.rest_lengths_m.push_back(v);
+    }
+  }
+
+  if (const auto it = doc.find("provenance"); it != doc.end()) {
+    const json& p = *it;
+    if (!p.is_object()) fail(source, "provenance", "must be an object");
+    policy.provenance.method = p.value("method", "");
+    if (p.contains("seed")) policy.provenance.seed = static_cast<std::uint64_t>(integer(p["seed"], source, "provenance.seed"));
+    if (p.contains("episodes")) policy.provenance.episodes = integer(p["episodes"], source, "provenance.episodes");
+    if (p.contains("score_m")) policy.provenance.score_m = finite_number(p["score_m"], source, "provenance.score_m");
+    policy.provenance.robot_hash = p.value("robot_hash", "");
+    policy.provenance.created_by = p.value("created_by", "");
+  }
+  return policy;
+}
+
+Policy load_policy(const std::filesystem::path& path, const Robot& robot) {
+  std::ifstream in(path);
+  if (!in) throw PolicyError(path.string() + ": cannot open policy file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_policy(buffer.str(), robot, path.string());
+}
+
+std::string policy_to_json(const Policy& policy) {
+  json cables = json::array();
+  for (const auto& c : policy.cables) {
+    cables.push_back({{"cable", c.cable}, {"owner", c.owner}, {"rest_lengths_m", c.rest_lengths_m}});
+  }
+  const json doc = {
+      {"format", "tensegrity-policy/1"},
+      {"robot", policy.robot},
+      {"period_s", policy.period_s},
+      {"complexity", policy.complexity},
+      {"cables", cables},
+      {"provenance",
+       {{"method", policy.provenance.method},
+        {"seed", policy.provenance.seed},
+        {"episodes", policy.provenance.episodes},
+        {"score_m", policy.provenance.score_m},
+        {"robot_hash", policy.provenance.robot_hash},
+        {"created_by", policy.provenance.created_by}}},
+  };
+  return doc.dump(2) + "\n";
+}
+
+void save_policy(const std::filesystem::path& path, const Policy& policy) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    if (!out) throw PolicyError(tmp.string() + ": cannot write");
+    out << policy_to_json(policy);
+    out.flush();
+    if (!out) throw PolicyError(tmp.string() + ": write failed");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+core::EndcapTable endcap_table(const Policy& policy, const Robot& robot, int endcap) {
+  core::EndcapTable table;
+  const std::vector<int> owned = robot.cables_of(endcap);
+  if (owned.size() > core::kMaxMotorsPerEndcap) {
+    throw PolicyError("end cap " + std::to_string(endcap) + " owns more cables than the core supports");
+  }
+  table.motor_count = static_cast<std::uint32_t>(owned.size());
+  table.complexity = static_cast<std::uint32_t>(policy.complexity);
+  table.period_s = policy.period_s;
+  for (std::size_t k = 0; k < owned.size(); ++k) {
+    const auto& values = policy.cables.at(owned[k]).rest_lengths_m;
+    for (std::size_t j = 0; j < values.size(); ++j) table.rest_length_m[k][j] = values[j];
+  }
+  return table;
+}
+
+}  // namespace tensegrity::sim

@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The policy file (format "tensegrity-policy/1"): a periodic table of preferred rest
+// lengths per cable, which end cap owns each cable, and where the policy came from.
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "firmware/core/table.hpp"
+#include "sim/robot.hpp"
+
+namespace tensegrity::sim {
+
+class PolicyError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CablePolicy {
+  int cable = 0;
+  int owner = 0;
+  std::vector<double> rest_lengths_m;  // `complexity` values
+};
+
+struct Provenance {
+  std::string method;  // historical | leniency | average | hand
+  std::uint64_t seed = 0;
+  std::int64_t episodes = 0;
+  double score_m = 0.0;
+  std::string robot_hash;
+  std::string created_by = "tensegrity";
+};
+
+struct Policy {
+  std::string robot;
+  double period_s = 0.0;
+  int complexity = 0;
+  std::vector<CablePolicy> cables;  // indexed by cable
+  Provenance provenance;
+};
+
+// Parses and validates against `robot`: robot name, one entry per cable with its
+// owner, `complexity` finite values within the rest-length limits, period > 0.
+// Errors name the source and the field.
+Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source = "policy");
+Policy load_policy(const std::filesystem::path& path, const Robot& robot);
+std::string policy_to_json(const Policy& policy);
+// Writes to a temporary file beside `path`, then renames: never a half-written policy.
+void save_policy(const std::filesystem::path& path, const Policy& policy);
+
+// The share of end cap `endcap`: its cables in increasing index, as the core plays it.
+core::EndcapTable endcap_table(const Policy& policy, const Robot& robot, int endcap);
+
+}  // namespace tensegrity::sim

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The robot description: geometry, masses, cables and their owners, actuator limits,
+// ground and start. Loaded from JSON (robots/*.json) and validated field by field.
+#include <Eigen/Core>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "firmware/core/limits.hpp"
+
+namespace tensegrity::sim {
+
+class RobotError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CableSpec {
+  int node_a = 0;
+  int node_b = 0;
+  int owner = 0;  // end cap (node) whose motor drives this cable
+  double stiffness_n_per_m = 0.0;
+  double damping_n_s_per_m = 0.0;
+};
+
+struct StrutSpec {
+  int node_a = 0;
+  int node_b = 0;
+};
+
+struct Robot {
+  std::string name;
+  std::vector<Eigen::Vector3d> nodes_m;
+  std::vector<StrutSpec> struts;
+  std::vector<CableSpec> cables;
+  double strut_mass_kg = 0.0;
+  double strut_radius_m = 0.0;
+  // Viscous damping of a strut's spin about its own axis (see docs/model.md): the
+  // cable attachments at real end caps resist it; point-attached cables cannot.
+  double axial_damping_n_m_s = 0.0;
+  double initial_rest_length_m = 0.0;
+  core::MotorLimits motor;
+  double gravity_m_per_s2 = 9.81;
+  double time_step_s = 0.001;
+  double ground_friction = 1.0;
+  double ground_restitution = 0.0;
+  double contact_stiffness_n_per_m = 5e5;
+  double contact_damping_n_s_per_m = 2e3;
+  // Start: the lowest end cap's surface this far above the ground, then settle.
+  double start_clearance_m = 0.05;
+  double settle_s = 4.0;
+  // FNV-1a 64 of the canonical JSON, as 16 hex digits: names the exact model a
+  // policy was learned on.
+  std::string hash;
+
+  int node_count() const { return static_cast<int>(nodes_m.size()); }
+  int cable_count() const { return static_cast<int>(cables.size()); }
+  int endcap_count() const { return node_count(); }
+  // Cables owned by end cap `endcap`, in increasing cable index.
+  std::vector<int> cables_of(int endcap) const;
+};
+
+// Parses and validates; errors name the source and the JSON path of the bad field.
+Robot parse_robot(const std::string& json_text, const std::string& source = "robot");
+Robot load_robot(const std::filesystem::path& path);
+// The shipped default: robots/superball.json, found via TENSEGRITY_ROBOTS_DIR, the
+// source tree this binary was built from, or ./robots.
+std::filesystem::path default_robot_path();
+// FNV-1a 64-bit of `text`, as 16 lower-case hex digits.
+std::string fnv1a64_hex(const std::string& text);
+
+}  // namespace tensegrity::sim
