@@ -1,0 +1,212 @@
+// SPDX-License-Identifier: Apache-2.0
+// The end cap's CANopen master (CiA 301 subset) for one CiA 402 drive in cyclic
+// synchronous position mode and one load-cell node. Per control cycle the
+// application:
+//   1. drains the bus: while (bus.receive(f, 0) == ok) master.on_frame(f, now);
+//   2. master.poll(now)              heartbeat and SDO timeouts, bring-up steps
+//   3. reads drive(), load_cell(), pop_event()
+//   4. master.write_target(length)   RPDO1: controlword + target position
+//   5. master.send_sync()            the drive latches the target, nodes answer with TPDOs
+// (In HIL lockstep the emulator may produce SYNC instead; on_frame records it.)
+// Nothing after construction allocates or throws; every frame is checked and a
+// rejected one is counted in rx_drops() and otherwise ignored.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/drivers/cia402.hpp"
+#include "firmware/drivers/cia402_power.hpp"
+#include "firmware/drivers/emcy.hpp"
+#include "firmware/drivers/event_queue.hpp"
+#include "firmware/drivers/heartbeat_monitor.hpp"
+#include "firmware/drivers/nmt.hpp"
+#include "firmware/drivers/rx_drop.hpp"
+#include "firmware/drivers/sdo_client.hpp"
+#include "firmware/drivers/spool_geometry.hpp"
+#include "firmware/hal/can_bus.hpp"
+
+namespace tensegrity::fw::canopen {
+
+enum class NodeRole : std::uint8_t { drive, load_cell };
+
+struct CanopenMasterConfig {
+  std::uint8_t drive_node_id = 1;
+  std::uint8_t load_cell_node_id = 2;
+  bool use_load_cell = true;
+  // Per node: a few producer periods (nodes here beat every 20 ms or so).
+  std::int64_t drive_heartbeat_timeout_ns = 100'000'000;
+  std::int64_t load_cell_heartbeat_timeout_ns = 100'000'000;
+  std::int64_t sdo_timeout_ns = 50'000'000;
+  std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
+  std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
+  SpoolGeometry spool;
+};
+
+struct DriveStatus {
+  bool seen = false;  // a TPDO1 has arrived
+  std::uint16_t statusword = 0;
+  Cia402State state = Cia402State::not_ready_to_switch_on;
+  std::int32_t position_counts = 0;
+  std::int32_t velocity_counts_per_s = 0;
+  std::int8_t mode_display = 0;
+  double rest_length_m = 0.0;             // from position through the spool
+  double rest_length_rate_m_per_s = 0.0;  // from velocity
+  std::int64_t position_updated_ns = 0;
+  std::int64_t velocity_updated_ns = 0;
+  std::uint16_t controlword_sent = 0;
+  std::int32_t target_sent_counts = 0;
+  bool has_emcy = false;
+  EmcyMessage last_emcy;
+};
+
+struct LoadCellStatus {
+  bool seen = false;
+  std::array<double, 2> tension_n{};
+  std::array<bool, 2> valid{};  // channel valid and not over range, no ADC fault
+  std::uint8_t status = 0;
+  std::uint8_t sequence = 0;
+  std::uint32_t stale_samples = 0;  // sequence did not advance
+  std::int64_t updated_ns = 0;
+  bool has_emcy = false;
+  EmcyMessage last_emcy;
+};
+
+struct SyncStatus {
+  std::uint64_t sent = 0;
+  std::uint64_t received = 0;  // from another producer (the HIL in lockstep)
+  std::uint8_t last_counter = 0;
+  std::int64_t last_received_ns = 0;
+};
+
+enum class MasterEventKind : std::uint8_t {
+  boot_up,
+  heartbeat_lost,
+  heartbeat_restored,
+  emcy,
+  drive_fault,          // drive entered fault reaction / fault
+  drive_fault_cleared,  // drive left fault
+  sdo_finished,         // done, aborted or timed out: see sdo_transfer()
+  bring_up_done,
+  bring_up_failed,      // see bring_up_failure()
+};
+
+const char* to_string(MasterEventKind kind);
+
+struct MasterEvent {
+  MasterEventKind kind = MasterEventKind::boot_up;
+  std::uint8_t node_id = 0;
+  std::int64_t time_ns = 0;
+  EmcyMessage emcy;  // kind == emcy
+};
+
+enum class BringUpStep : std::uint8_t {
+  idle,
+  wait_boot,     // after NMT reset communication: wait for each node's boot-up/heartbeat
+  set_mode,      // SDO 0x6060 = 8 (cyclic synchronous position)
+  check_mode,    // SDO 0x6061 must read 8
+  start_nodes,   // NMT start; wait for heartbeats saying operational
+  enable,        // CiA 402 power-up to operation enabled (needs write_target each cycle)
+  done,
+  failed,
+};
+
+const char* to_string(BringUpStep step);
+
+class CanopenMaster {
+ public:
+  static constexpr std::size_t kEventCapacity = 32;
+
+  CanopenMaster(CanBus& bus, const CanopenMasterConfig& config);
+
+  void on_frame(const CanFrame& frame, std::int64_t now_ns);
+  void poll(std::int64_t now_ns);
+
+  // Sends RPDO1. The target is the commanded rest length unless the drive is not
+  // in operation enabled: then it is the drive's own position, so enabling never
+  // jumps (seed the motor loop from drive().rest_length_m before enabling). A
+  // non-finite length is refused and the drive holds position.
+  CanResult write_target(double rest_length_m);
+  CanResult send_sync();
+  CanResult send_nmt(NmtCommand command, std::uint8_t node_id);  // node 0: all
+
+  void request_power(PowerRequest request) { power_.request(request); }
+  void request_fault_reset() { power_.request_fault_reset(); }
+  PowerRequest power_request() const { return power_.requested(); }
+
+  // Reset communication, then set CSP, verify it, start the nodes, enable the drive.
+  void start_bring_up(std::int64_t now_ns);
+  BringUpStep bring_up_step() const { return bring_up_.step; }
+  const char* bring_up_failure() const { return bring_up_.failure.data(); }
+
+  // One expedited transfer per node at a time; false when busy or unknown node.
+  bool sdo_upload(NodeRole node, SdoAddress address, std::int64_t now_ns);
+  bool sdo_download(NodeRole node, SdoAddress address, std::uint32_t value, std::uint8_t size_bytes,
+                    std::int64_t now_ns);
+  const SdoTransfer& sdo_transfer(NodeRole node) const { return sdo_client(node).transfer(); }
+  void sdo_acknowledge(NodeRole node) { sdo_client(node).acknowledge(); }
+
+  const DriveStatus& drive() const { return drive_; }
+  const LoadCellStatus& load_cell() const { return load_cell_; }
+  const HeartbeatStatus& heartbeat(NodeRole node) const {
+    return node == NodeRole::drive ? drive_hb_.status() : load_cell_hb_.status();
+  }
+  const SyncStatus& sync() const { return sync_; }
+  bool pop_event(MasterEvent& event) { return events_.pop(event); }
+  std::uint64_t events_lost() const { return events_.overflows(); }
+  const RxDropCounters& rx_drops() const { return drops_; }
+  std::uint64_t frames_accepted() const { return frames_accepted_; }
+  std::uint64_t targets_refused() const { return targets_refused_; }
+  const CanopenMasterConfig& config() const { return config_; }
+
+ private:
+  struct BringUp {
+    BringUpStep step = BringUpStep::idle;
+    std::int64_t step_started_ns = 0;
+    bool request_sent = false;
+    std::array<char, 128> failure{};
+  };
+
+  SdoClient& sdo_client(NodeRole node) { return node == NodeRole::drive ? drive_sdo_ : load_cell_sdo_; }
+  const SdoClient& sdo_client(NodeRole node) const {
+    return node == NodeRole::drive ? drive_sdo_ : load_cell_sdo_;
+  }
+  bool role_of(std::uint8_t node_id, NodeRole& role) const;
+  std::uint8_t node_id(NodeRole role) const {
+    return role == NodeRole::drive ? config_.drive_node_id : config_.load_cell_node_id;
+  }
+  void emit(MasterEventKind kind, std::uint8_t node_id, std::int64_t now_ns);
+  void drop(RxDrop reason) { drops_.count(reason); }
+  void accept() { ++frames_accepted_; }
+
+  void on_heartbeat(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
+  void on_emcy(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
+  void on_drive_tpdo1(const CanFrame& frame, std::int64_t now_ns);
+  void on_drive_tpdo2(const CanFrame& frame, std::int64_t now_ns);
+  void on_load_cell_tpdo1(const CanFrame& frame, std::int64_t now_ns);
+  void on_sdo(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
+  void on_sync(const CanFrame& frame, std::int64_t now_ns);
+
+  void step_bring_up(std::int64_t now_ns);
+  void enter_step(BringUpStep step, std::int64_t now_ns);
+  void fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t detail = 0);
+
+  CanBus& bus_;
+  CanopenMasterConfig config_;
+  HeartbeatMonitor drive_hb_;
+  HeartbeatMonitor load_cell_hb_;
+  SdoClient drive_sdo_;
+  SdoClient load_cell_sdo_;
+  Cia402PowerControl power_;
+  DriveStatus drive_;
+  LoadCellStatus load_cell_;
+  SyncStatus sync_;
+  std::uint8_t next_sync_counter_ = 1;
+  BringUp bring_up_;
+  EventQueue<MasterEvent, kEventCapacity> events_;
+  RxDropCounters drops_;
+  std::uint64_t frames_accepted_ = 0;
+  std::uint64_t targets_refused_ = 0;
+};
+
+}  // namespace tensegrity::fw::canopen

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: Apache-2.0
+// CiA 402 drive profile: the power state machine as the statusword (0x6041)
+// reports it, and the controlword (0x6040) commands that move it. Pure functions,
+// shared by the master's drive client and emulated drives.
+#pragma once
+
+#include <cstdint>
+
+namespace tensegrity::fw::canopen {
+
+// Object dictionary entries of the drive we use.
+inline constexpr std::uint16_t kOdControlword = 0x6040;
+inline constexpr std::uint16_t kOdStatusword = 0x6041;
+inline constexpr std::uint16_t kOdModesOfOperation = 0x6060;
+inline constexpr std::uint16_t kOdModesOfOperationDisplay = 0x6061;
+inline constexpr std::uint16_t kOdPositionActual = 0x6064;
+inline constexpr std::uint16_t kOdVelocityActual = 0x606C;
+inline constexpr std::uint16_t kOdTargetPosition = 0x607A;
+inline constexpr std::int8_t kModeCyclicSynchronousPosition = 8;
+
+enum class Cia402State : std::uint8_t {
+  not_ready_to_switch_on,
+  switch_on_disabled,
+  ready_to_switch_on,
+  switched_on,
+  operation_enabled,
+  quick_stop_active,
+  fault_reaction_active,
+  fault,
+  invalid,  // statusword bits match no state
+};
+
+enum class Cia402Command : std::uint8_t {
+  shutdown,          // -> ready to switch on
+  switch_on,         // -> switched on
+  enable_operation,  // -> operation enabled (also from switched on)
+  disable_operation, // operation enabled -> switched on
+  disable_voltage,   // -> switch on disabled
+  quick_stop,        // operation enabled -> quick stop active
+  fault_reset,       // fault -> switch on disabled, on the 0->1 edge of bit 7
+};
+
+// Statusword bits beyond the state.
+inline constexpr std::uint16_t kSwVoltageEnabled = 1U << 4;
+inline constexpr std::uint16_t kSwWarning = 1U << 7;
+inline constexpr std::uint16_t kSwRemote = 1U << 9;
+inline constexpr std::uint16_t kSwTargetReached = 1U << 10;
+inline constexpr std::uint16_t kSwFollowingError = 1U << 13;
+inline constexpr std::uint16_t kCwFaultReset = 1U << 7;
+
+const char* to_string(Cia402State state);
+const char* to_string(Cia402Command command);
+
+Cia402State decode_statusword(std::uint16_t statusword);
+// The state bits a drive reports (others zero), for emulated drives.
+std::uint16_t statusword_bits(Cia402State state);
+std::uint16_t controlword_bits(Cia402Command command);
+// What a drive makes of a controlword, by the bits CiA 402 table 48 reads.
+// Fault reset is reported only when bit 7 is set; the edge is the drive's concern.
+bool decode_controlword(std::uint16_t controlword, Cia402Command& command);
+
+// What the master asks of the drive.
+enum class PowerRequest : std::uint8_t {
+  disabled,            // voltage off, motor free
+  operation_enabled,   // follow the target position
+  quick_stop,          // stop now, then hold in quick stop
+};
+
+}  // namespace tensegrity::fw::canopen

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: Apache-2.0
+// Text form of a CAN bus choice, as given on a command line or in a config file:
+//   udp:HOST:PORT[,bind=HOST:PORT]   frames over UDP to HOST:PORT (docs/udp-can.md);
+//                                    bind defaults to 0.0.0.0:0 (any port)
+//   socketcan:IFNAME                 a Linux CAN interface, e.g. can0 or vcan0
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace tensegrity::fw {
+
+struct UdpEndpoint {
+  std::string host = "0.0.0.0";  // IPv4 address or host name
+  std::uint16_t port = 0;
+};
+
+struct CanBusSpec {
+  enum class Kind : std::uint8_t { udp, socketcan };
+  Kind kind = Kind::udp;
+  UdpEndpoint remote;         // udp
+  UdpEndpoint bind;           // udp
+  std::string interface_name; // socketcan
+};
+
+// "HOST:PORT"; port 0..65535, host non-empty.
+bool parse_udp_endpoint(std::string_view text, UdpEndpoint& out, std::string& error);
+// False with a one-line reason in `error` for anything malformed.
+bool parse_can_bus_spec(std::string_view spec, CanBusSpec& out, std::string& error);
+
+}  // namespace tensegrity::fw

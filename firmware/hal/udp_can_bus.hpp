@@ -1,0 +1,56 @@
+// SPDX-License-Identifier: Apache-2.0
+// CanBus over UDP, for kernels without AF_CAN and for the HIL emulator. Wire format:
+// udp_can_wire.hpp and docs/udp-can.md. The socket is unconnected: frames are sent
+// to the configured remote and accepted from any sender, so an emulator may answer
+// from whichever socket it likes.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "firmware/hal/can_bus.hpp"
+#include "firmware/hal/can_bus_spec.hpp"
+#include "firmware/hal/udp_can_wire.hpp"
+
+namespace tensegrity::fw {
+
+struct UdpCanConfig {
+  UdpEndpoint remote;  // where send() goes; port 0 = not yet known (set_remote later)
+  UdpEndpoint bind;    // local address; port 0 = any free port (see local_port())
+};
+
+class UdpCanBus final : public CanBus {
+ public:
+  // nullptr and a one-line reason in `error` when the socket cannot be made.
+  static std::unique_ptr<UdpCanBus> open(const UdpCanConfig& config, std::string& error);
+  ~UdpCanBus() override;
+  UdpCanBus(const UdpCanBus&) = delete;
+  UdpCanBus& operator=(const UdpCanBus&) = delete;
+
+  CanResult send(const CanFrame& frame) override;
+  CanResult receive(CanFrame& frame, std::int64_t timeout_ns) override;
+  CanCounters counters() const override { return counters_; }
+
+  bool set_remote(const UdpEndpoint& remote, std::string& error);
+  std::uint16_t local_port() const { return local_port_; }
+  // Datagrams dropped for `reason` (frame and error_report count as received).
+  std::uint64_t dropped(udp_can::Decoded reason) const {
+    return drops_[static_cast<std::size_t>(reason)];
+  }
+  int last_errno() const { return last_errno_; }
+
+ private:
+  UdpCanBus(int fd, std::uint16_t local_port);
+
+  int fd_;
+  std::uint16_t local_port_;
+  std::uint32_t remote_addr_be_ = 0;  // network byte order, as sockaddr_in wants
+  std::uint16_t remote_port_be_ = 0;
+  CanCounters counters_;
+  std::array<std::uint64_t, udp_can::kDecodedCount> drops_{};
+  int last_errno_ = 0;
+};
+
+}  // namespace tensegrity::fw
