@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/episode.hpp"
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -15,11 +16,40 @@ double resolve_dt(const Robot& robot, double dt_s) { return dt_s > 0.0 ? dt_s : 
 
 Eigen::Vector2d horizontal(const Eigen::Vector3d& p) { return {p.x(), p.y()}; }
 
-}  // namespace
+// The description's pose turned so that a closed cable triangle faces straight
+// down: the robot then lands on three end caps instead of balancing on an edge,
+// where the description's symmetric pose would leave it until round-off tips it.
+std::vector<Eigen::Vector3d> face_down_pose(const Robot& robot) {
+  const int n = robot.node_count();
+  std::vector<std::vector<bool>> linked(n, std::vector<bool>(n, false));
+  for (const auto& c : robot.cables) linked[c.node_a][c.node_b] = linked[c.node_b][c.node_a] = true;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : robot.nodes_m) centre += p / n;
+  Eigen::Vector3d best_normal(0.0, 0.0, -1.0);
+  double best_z = 2.0;
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      for (int c = b + 1; c < n; ++c) {
+        if (!linked[a][b] || !linked[b][c] || !linked[a][c]) continue;
+        const auto& pa = robot.nodes_m[a];
+        Eigen::Vector3d normal = (robot.nodes_m[b] - pa).cross(robot.nodes_m[c] - pa).normalized();
+        const Eigen::Vector3d face = (pa + robot.nodes_m[b] + robot.nodes_m[c]) / 3.0;
+        if (normal.dot(face - centre) < 0.0) normal = -normal;
+        if (normal.z() < best_z - 1e-12) {
+          best_z = normal.z();
+          best_normal = normal;
+        }
+      }
+    }
+  }
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(best_normal, -Eigen::Vector3d::UnitZ());
+  std::vector<Eigen::Vector3d> nodes;
+  for (const auto& p : robot.nodes_m) nodes.push_back(centre + turn * (p - centre));
+  return nodes;
+}
 
-ModelState drop_state(const Robot& robot, double dt_s) {
+ModelState dropped(const Robot& robot, double dt_s, std::vector<Eigen::Vector3d> nodes) {
   Model model(robot, resolve_dt(robot, dt_s));
-  std::vector<Eigen::Vector3d> nodes = robot.nodes_m;
   double lowest = nodes.front().z();
   for (const auto& p : nodes) lowest = std::min(lowest, p.z());
   const double lift = robot.start_clearance_m + robot.strut_radius_m - lowest;
@@ -27,6 +57,10 @@ ModelState drop_state(const Robot& robot, double dt_s) {
   model.place(nodes);
   return model.save();
 }
+
+}  // namespace
+
+ModelState drop_state(const Robot& robot, double dt_s) { return dropped(robot, dt_s, robot.nodes_m); }
 
 const ModelState& settled_state(const Robot& robot, double dt_s) {
   dt_s = resolve_dt(robot, dt_s);
@@ -36,7 +70,7 @@ const ModelState& settled_state(const Robot& robot, double dt_s) {
   auto& slot = cache[{robot.hash + robot.name, dt_s}];
   if (!slot) {
     Model model(robot, dt_s);
-    model.restore(drop_state(robot, dt_s));
+    model.restore(dropped(robot, dt_s, face_down_pose(robot)));
     const std::vector<double> hold(robot.cables.size(), robot.initial_rest_length_m);
     const auto steps = static_cast<std::int64_t>(std::llround(robot.settle_s / dt_s));
     for (std::int64_t i = 0; i < steps; ++i) model.step(hold);
@@ -79,8 +113,21 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
     input.tension_n = last_tension;
     input.rest_length_m = model.rest_length_m();
     controller.update(input, preferred);
-    model.step(preferred);
+    try {
+      model.step(preferred);
+    } catch (const ModelDiverged& e) {
+      result.feasible = false;
+      result.infeasible_reason = std::string("the model diverged: ") + e.what();
+      result.infeasible_time_s = static_cast<double>(k) * dt;
+      break;
+    }
     ++done;
+    if (model.diverged()) {
+      result.feasible = false;
+      result.infeasible_reason = "the model diverged (non-finite or runaway state)";
+      result.infeasible_time_s = static_cast<double>(k) * dt;
+      break;
+    }
 
     const auto tension = model.tension_n();
     const auto rate = model.rest_length_rate_m_per_s();
@@ -104,12 +151,6 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
       why << "cable " << worst << " tension " << step_max << " N above the hard limit " << hard_limit << " N";
       result.feasible = false;
       result.infeasible_reason = why.str();
-      result.infeasible_time_s = now;
-      break;
-    }
-    if ((k & 63) == 63 && !model.state_finite()) {
-      result.feasible = false;
-      result.infeasible_reason = "state not finite (the model diverged)";
       result.infeasible_time_s = now;
       break;
     }

@@ -14,7 +14,7 @@
 namespace tensegrity::sim {
 
 enum class StartKind {
-  settled,  // dropped, then left to settle for the robot's settle_s: "from rest"
+  settled,  // a cable triangle face down, dropped, settled for settle_s: "from rest"
   drop,     // the description's pose, lowest end cap clearance_m above the ground
 };
 
@@ -46,7 +46,8 @@ struct EpisodeResult {
 // The description's node pose, shifted so the lowest end cap's surface is
 // clearance_m above the ground.
 ModelState drop_state(const Robot& robot, double dt_s);
-// Dropped and settled for settle_s with every rest length at its initial value.
+// Turned so a closed cable triangle faces down, dropped, and settled for settle_s
+// with every rest length at its initial value.
 // Computed once per robot and time step, then shared (thread-safe).
 const ModelState& settled_state(const Robot& robot, double dt_s);
 

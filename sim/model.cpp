@@ -5,16 +5,31 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <mutex>
+#include <string>
 
 #include "firmware/core/rate_limit.hpp"
 
 namespace tensegrity::sim {
 namespace {
 
+// ODE's debug checks call abort() after the handler returns; throwing instead turns
+// a diverged world into an error the episode can report, not a dead process.
+[[noreturn]] void ode_fault(int code, const char* message, va_list args) {
+  char text[512];
+  std::vsnprintf(text, sizeof text, message, args);
+  throw ModelDiverged("ODE error " + std::to_string(code) + ": " + text);
+}
+
 void init_ode_for_this_thread() {
   static std::once_flag once;
-  std::call_once(once, [] { dInitODE2(0); });
+  std::call_once(once, [] {
+    dInitODE2(0);
+    dSetErrorHandler(ode_fault);
+    dSetDebugHandler(ode_fault);
+  });
   thread_local const bool allocated = [] {
     dAllocateODEDataForThread(dAllocateMaskAll);
     return true;
@@ -104,6 +119,7 @@ void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
   std::fill(rest_rate_m_per_s_.begin(), rest_rate_m_per_s_.end(), 0.0);
   update_cable_geometry();
   std::fill(tension_n_.begin(), tension_n_.end(), 0.0);
+  diverged_ = false;
 }
 
 ModelState Model::save() const {
@@ -137,6 +153,7 @@ void Model::restore(const ModelState& state) {
   }
   rest_length_m_ = state.rest_length_m;
   tension_n_ = state.tension_n;
+  diverged_ = false;
   std::fill(rest_rate_m_per_s_.begin(), rest_rate_m_per_s_.end(), 0.0);
   update_cable_geometry();
 }
@@ -239,11 +256,32 @@ void Model::step(std::span<const double> preferred_rest_length_m) {
     rest_rate_m_per_s_[m] = (next - rest_length_m_[m]) / dt_s_;
     rest_length_m_[m] = next;
   }
+  if (diverged_) return;
   update_cable_geometry();
   apply_forces();
+  if (!forces_sane()) {
+    // Stepping on would hand ODE non-finite numbers; stop here and say so.
+    diverged_ = true;
+    dJointGroupEmpty(ode_->contacts);
+    return;
+  }
   add_ground_contacts();
   dWorldStep(ode_->world, dt_s_);
   dJointGroupEmpty(ode_->contacts);
+}
+
+bool Model::forces_sane() const {
+  // A robot of metre-sized struts has no business moving at 1 km/s: past that the
+  // integration has diverged, well before the numbers overflow.
+  constexpr double kMaxSpeed = 1e3;
+  double sum = 0.0;
+  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+    sum += force_[s].sum() + torque_[s].sum();
+    const Eigen::Vector3d v = vec(dBodyGetLinearVel(ode_->bodies[s]));
+    const Eigen::Vector3d w = vec(dBodyGetAngularVel(ode_->bodies[s]));
+    if (!(v.squaredNorm() < kMaxSpeed * kMaxSpeed) || !(w.squaredNorm() < 1e2 * kMaxSpeed * kMaxSpeed)) return false;
+  }
+  return std::isfinite(sum);
 }
 
 Eigen::Vector3d Model::node_position(int node) const {

@@ -5,11 +5,18 @@
 #include <Eigen/Core>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "sim/robot.hpp"
 
 namespace tensegrity::sim {
+
+// Thrown when ODE reports an internal error (a diverged world).
+class ModelDiverged : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // Full dynamic state, enough to restart a run bit-identically from a snapshot.
 struct ModelState {
@@ -57,6 +64,8 @@ class Model {
   void set_velocity(int strut, const Eigen::Vector3d& linear_m_per_s,
                     const Eigen::Vector3d& angular_rad_per_s);
   bool state_finite() const;
+  // The integration blew up (non-finite or absurd speeds); the model stops stepping.
+  bool diverged() const { return diverged_; }
   int contact_count() const { return contact_count_; }
 
   // Switches for the energy-conservation test; defaults follow the robot.
@@ -69,6 +78,7 @@ class Model {
   void update_cable_geometry();
   void apply_forces();
   void add_ground_contacts();
+  bool forces_sane() const;
 
   Robot robot_;
   double dt_s_;
@@ -83,6 +93,7 @@ class Model {
   bool ground_enabled_ = true;
   bool damping_enabled_ = true;
   int contact_count_ = 0;
+  bool diverged_ = false;
 };
 
 }  // namespace tensegrity::sim

@@ -40,7 +40,7 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
   json doc;
   try {
     doc = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw PolicyError(source + ": not valid JSON: " + e.what());
   }
   Policy policy;

@@ -121,7 +121,7 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   json doc;
   try {
     doc = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw RobotError(source + ": not valid JSON: " + e.what());
   }
   const Reader r(doc, source, "");

@@ -1,0 +1,129 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "sim/policy.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+
+namespace tensegrity::sim {
+namespace {
+
+using ::testing::HasSubstr;
+using nlohmann::json;
+
+class PolicyFile : public ::testing::Test {
+ protected:
+  Robot robot = load_robot(default_robot_path());
+
+  json good() const {
+    Policy p;
+    p.robot = robot.name;
+    p.period_s = 4.0;
+    p.complexity = 5;
+    for (int m = 0; m < 24; ++m) {
+      p.cables.push_back({m, robot.cables[m].owner, {0.7, 0.8, 0.9, 1.0, 1.1}});
+    }
+    p.provenance = {"historical", 7, 5000, 33.5, robot.hash, "test"};
+    return json::parse(policy_to_json(p));
+  }
+  std::string error_of(const json& doc) const {
+    try {
+      parse_policy(doc.dump(), robot, "p.json");
+    } catch (const PolicyError& e) {
+      return e.what();
+    }
+    return "";
+  }
+};
+
+TEST_F(PolicyFile, RoundTrips) {
+  const Policy p = parse_policy(good().dump(), robot);
+  EXPECT_EQ(p.complexity, 5);
+  EXPECT_EQ(p.period_s, 4.0);
+  EXPECT_EQ(p.cables[13].owner, 3);
+  EXPECT_EQ(p.cables[13].rest_lengths_m[2], 0.9);
+  EXPECT_EQ(p.provenance.seed, 7U);
+  EXPECT_EQ(p.provenance.robot_hash, robot.hash);
+  const auto path = std::filesystem::path(::testing::TempDir()) / "policy_roundtrip.json";
+  save_policy(path, p);
+  const Policy q = load_policy(path, robot);
+  EXPECT_EQ(q.cables[23].rest_lengths_m, p.cables[23].rest_lengths_m);
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp"));
+  std::filesystem::remove(path);
+}
+
+TEST_F(PolicyFile, EndcapTableHoldsTheOwnedCablesInOrder) {
+  json doc = good();
+  doc["cables"][9]["rest_lengths_m"][0] = 0.61;   // cable 9 is end cap 2's first
+  doc["cables"][10]["rest_lengths_m"][0] = 0.62;  // cable 10 its second
+  const Policy p = parse_policy(doc.dump(), robot);
+  const auto table = endcap_table(p, robot, 2);
+  EXPECT_EQ(table.motor_count, 2U);
+  EXPECT_EQ(table.complexity, 5U);
+  EXPECT_EQ(table.rest_length_m[0][0], 0.61);
+  EXPECT_EQ(table.rest_length_m[1][0], 0.62);
+}
+
+TEST_F(PolicyFile, EachBadFieldIsNamed) {
+  json doc = good();
+  doc["format"] = "tensegrity-policy/2";
+  EXPECT_THAT(error_of(doc), HasSubstr("p.json: format"));
+  doc = good();
+  doc["robot"] = "ballerina";
+  EXPECT_THAT(error_of(doc), HasSubstr("robot: policy is for robot \"ballerina\""));
+  doc = good();
+  doc["period_s"] = 0.0;
+  EXPECT_THAT(error_of(doc), HasSubstr("period_s: must be within (0, 3600]"));
+  doc = good();
+  doc["period_s"] = -4.0;
+  EXPECT_THAT(error_of(doc), HasSubstr("period_s"));
+  doc = good();
+  doc["complexity"] = 0;
+  EXPECT_THAT(error_of(doc), HasSubstr("complexity: must be 1..16"));
+  doc = good();
+  doc["cables"].erase(5);
+  EXPECT_THAT(error_of(doc), HasSubstr("cables: has 23 entries, the robot has 24 cables"));
+  doc = good();
+  doc["cables"][4]["rest_lengths_m"].erase(1);
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[4].rest_lengths_m: must hold exactly 5 values"));
+  doc = good();
+  doc["cables"][6]["rest_lengths_m"][3] = 1.2;
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[6].rest_lengths_m[3]: 1.2 m is outside the rest-length limits"));
+  doc = good();
+  doc["cables"][6]["rest_lengths_m"][3] = "0.9";
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[6].rest_lengths_m[3]: must be a number"));
+  doc = good();
+  doc["cables"][1]["owner"] = 0;  // cable 1 (0-5) is end cap 5's
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[1].owner: cable 1 is owned by end cap 5, not 0"));
+  doc = good();
+  doc["cables"][2]["cable"] = 1;
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[2].cable: cable 1 appears twice"));
+  doc = good();
+  doc["cables"][2]["cable"] = 24;
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[2].cable: no such cable"));
+}
+
+TEST_F(PolicyFile, NonFiniteValueIsNamed) {
+  // JSON has no NaN; an overflowing literal is how a non-finite number arrives.
+  std::string text = good().dump();
+  const auto at = text.find("1.1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 3, "1e999");
+  try {
+    parse_policy(text, robot, "p.json");
+    FAIL();
+  } catch (const PolicyError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("p.json: not valid JSON"));
+    EXPECT_THAT(e.what(), HasSubstr("1e999"));
+  }
+}
+
+TEST_F(PolicyFile, MissingFileIsAClearError) {
+  EXPECT_THROW(load_policy("/nonexistent/policy.json", robot), PolicyError);
+}
+
+}  // namespace
+}  // namespace tensegrity::sim

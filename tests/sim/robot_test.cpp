@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "sim/robot.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace tensegrity::sim {
+namespace {
+
+using ::testing::HasSubstr;
+using nlohmann::json;
+
+json superball_json() {
+  std::ifstream in(default_robot_path());
+  std::stringstream s;
+  s << in.rdbuf();
+  return json::parse(s.str());
+}
+
+std::string error_of(const json& doc) {
+  try {
+    parse_robot(doc.dump(), "test.json");
+  } catch (const RobotError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Robot, ShippedSuperballLoads) {
+  const Robot robot = load_robot(default_robot_path());
+  EXPECT_EQ(robot.name, "superball");
+  EXPECT_EQ(robot.node_count(), 12);
+  EXPECT_EQ(robot.struts.size(), 6U);
+  EXPECT_EQ(robot.cable_count(), 24);
+  EXPECT_EQ(robot.hash.size(), 16U);
+  for (int e = 0; e < 12; ++e) EXPECT_EQ(robot.cables_of(e).size(), 2U) << "end cap " << e;
+  // All 24 cables of Fuller's expanded octahedron are the same length.
+  for (const auto& c : robot.cables) {
+    EXPECT_NEAR((robot.nodes_m[c.node_a] - robot.nodes_m[c.node_b]).norm(), 1.0408, 1e-3);
+  }
+}
+
+TEST(Robot, HashChangesWithContent) {
+  json doc = superball_json();
+  const Robot a = parse_robot(doc.dump());
+  doc["cable"]["stiffness_n_per_m"] = 1001.0;
+  const Robot b = parse_robot(doc.dump());
+  EXPECT_NE(a.hash, b.hash);
+}
+
+TEST(Robot, MissingCableEndNamed) {
+  json doc = superball_json();
+  doc["cables"][3]["nodes"] = json::array({0});
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cables[3].nodes: must be a pair"));
+  doc = superball_json();
+  doc["cables"][5]["nodes"][1] = 12;
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[5].nodes[1]: node 12 does not exist"));
+  doc = superball_json();
+  doc["cables"][2].erase("nodes");
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[2].nodes: missing"));
+}
+
+TEST(Robot, NonFiniteNumberNamed) {
+  json doc = superball_json();
+  doc["nodes_m"][4][2] = "nan";
+  EXPECT_THAT(error_of(doc), HasSubstr("nodes_m[4][2]: must be a number"));
+  // JSON has no NaN literal; a huge exponent parses to infinity.
+  std::string text = superball_json().dump();
+  const auto at = text.find("\"mass_kg\":3.5");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 13, "\"mass_kg\":1e999");
+  try {
+    parse_robot(text, "test.json");
+    FAIL() << "infinite mass accepted";
+  } catch (const RobotError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("test.json: not valid JSON"));
+    EXPECT_THAT(e.what(), HasSubstr("1e999"));
+  }
+}
+
+TEST(Robot, NegativeMassNamed) {
+  json doc = superball_json();
+  doc["strut"]["mass_kg"] = -3.5;
+  EXPECT_THAT(error_of(doc), HasSubstr("strut.mass_kg: must be > 0"));
+}
+
+TEST(Robot, CableAlongOneStrutNamed) {
+  json doc = superball_json();
+  doc["cables"][7]["nodes"] = json::array({0, 1});  // struts[0] is 0-1
+  doc["cables"][7]["owner"] = 0;
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[7].nodes: both ends are on struts[0]"));
+}
+
+TEST(Robot, OwnerNotAnEndNamed) {
+  json doc = superball_json();
+  doc["cables"][0]["owner"] = 7;  // cable 0 joins 0 and 4
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[0].owner: end cap 7 is not an end of this cable"));
+}
+
+TEST(Robot, OtherBadFieldsNamed) {
+  json doc = superball_json();
+  doc["format"] = "tensegrity-robot/9";
+  EXPECT_THAT(error_of(doc), HasSubstr("format: expected"));
+  doc = superball_json();
+  doc["cable"]["max_rest_length_m"] = 0.5;
+  EXPECT_THAT(error_of(doc), HasSubstr("cable.max_rest_length_m: must be greater than min_rest_length_m"));
+  doc = superball_json();
+  doc["cable"]["hard_limit_tension_n"] = 300.0;
+  EXPECT_THAT(error_of(doc), HasSubstr("cable.hard_limit_tension_n"));
+  doc = superball_json();
+  doc["struts"][1] = json::array({0, 3});
+  EXPECT_THAT(error_of(doc), HasSubstr("struts[1]: node 0 is already an end of struts[0]"));
+  doc = superball_json();
+  doc["time_step_s"] = 0.0;
+  EXPECT_THAT(error_of(doc), HasSubstr("time_step_s: must be > 0"));
+  doc = superball_json();
+  doc["ground"]["friction"] = -1;
+  EXPECT_THAT(error_of(doc), HasSubstr("ground.friction: must be >= 0"));
+  doc = superball_json();
+  doc["cables"][4]["nodes"] = doc["cables"][3]["nodes"];
+  doc["cables"][4]["owner"] = doc["cables"][3]["owner"];
+  EXPECT_THAT(error_of(doc), HasSubstr("cables[4].nodes: duplicate cable"));
+  EXPECT_THAT(error_of(json::parse("[1,2]")), HasSubstr("must be an object"));
+  try {
+    parse_robot("{not json", "broken.json");
+    FAIL();
+  } catch (const RobotError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("broken.json: not valid JSON"));
+  }
+}
+
+TEST(Robot, MissingFileIsAClearError) {
+  try {
+    load_robot("/nonexistent/robot.json");
+    FAIL();
+  } catch (const RobotError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent/robot.json: cannot open"));
+  }
+}
+
+}  // namespace
+}  // namespace tensegrity::sim
