@@ -91,6 +91,8 @@ Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_
   rest_rate_m_per_s_.assign(cables, 0.0);
   node_pos_.assign(nodes, Eigen::Vector3d::Zero());
   node_vel_.assign(nodes, Eigen::Vector3d::Zero());
+  node_arm_.assign(nodes, Eigen::Vector3d::Zero());
+  unit_.assign(cables, Eigen::Vector3d::Zero());
   force_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
   torque_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
   place(robot_.nodes_m);
@@ -163,6 +165,7 @@ void Model::update_cable_geometry() {
     const int s = strut_of_node_[node];
     dBodyID body = ode_->bodies[s];
     const Eigen::Vector3d r = (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
+    node_arm_[node] = r;
     node_pos_[node] = vec(dBodyGetPosition(body)) + r;
     node_vel_[node] = vec(dBodyGetLinearVel(body)) + vec(dBodyGetAngularVel(body)).cross(r);
   }
@@ -171,8 +174,8 @@ void Model::update_cable_geometry() {
     const Eigen::Vector3d d = node_pos_[cable.node_b] - node_pos_[cable.node_a];
     const double length = d.norm();
     length_m_[m] = length;
-    length_rate_m_per_s_[m] =
-        length > 0.0 ? (node_vel_[cable.node_b] - node_vel_[cable.node_a]).dot(d) / length : 0.0;
+    unit_[m] = length > 0.0 ? Eigen::Vector3d(d / length) : Eigen::Vector3d::Zero();
+    length_rate_m_per_s_[m] = (node_vel_[cable.node_b] - node_vel_[cable.node_a]).dot(unit_[m]);
   }
 }
 
@@ -191,14 +194,13 @@ void Model::apply_forces() {
     }
     tension_n_[m] = tension;
     if (tension == 0.0) continue;
-    const Eigen::Vector3d u = (node_pos_[cable.node_b] - node_pos_[cable.node_a]) / length_m_[m];
-    const Eigen::Vector3d f = tension * u;  // pulls node a toward b, b toward a
-    for (const auto& [node, force] : {std::pair{cable.node_a, f}, std::pair{cable.node_b, Eigen::Vector3d(-f)}}) {
-      const int s = strut_of_node_[node];
-      const Eigen::Vector3d r = node_pos_[node] - vec(dBodyGetPosition(ode_->bodies[s]));
-      force_[s] += force;
-      torque_[s] += r.cross(force);
-    }
+    const Eigen::Vector3d f = tension * unit_[m];  // pulls node a toward b, b toward a
+    const int sa = strut_of_node_[cable.node_a];
+    const int sb = strut_of_node_[cable.node_b];
+    force_[sa] += f;
+    torque_[sa] += node_arm_[cable.node_a].cross(f);
+    force_[sb] -= f;
+    torque_[sb] -= node_arm_[cable.node_b].cross(f);
   }
   for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
     dBodyID body = ode_->bodies[s];

@@ -89,7 +89,9 @@ class Model {
   std::vector<double> end_sign_of_node_;
   std::vector<double> rest_length_m_, length_m_, length_rate_m_per_s_, tension_n_,
       rest_rate_m_per_s_;
-  std::vector<Eigen::Vector3d> node_pos_, node_vel_, force_, torque_;
+  // Per node: world position, velocity, and arm from its strut's centre; per cable
+  // the unit vector from node a to node b.
+  std::vector<Eigen::Vector3d> node_pos_, node_vel_, node_arm_, unit_, force_, torque_;
   bool ground_enabled_ = true;
   bool damping_enabled_ = true;
   int contact_count_ = 0;
