@@ -10,10 +10,10 @@ namespace tensegrity::fw::canopen {
 
 void CanopenMaster::start_bring_up(std::int64_t now_ns) {
   bring_up_ = BringUp{};
-  power_.request(PowerRequest::disabled);
+  request_power(PowerRequest::disabled);
   // Reset communication makes every node announce itself with a boot-up message,
   // also when it was left operational by an earlier run of the firmware.
-  send_nmt(NmtCommand::reset_communication, config_.drive_node_id);
+  for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::reset_communication, config_.drive_node(i));
   if (config_.use_load_cell) send_nmt(NmtCommand::reset_communication, config_.load_cell_node_id);
   enter_step(BringUpStep::wait_boot, now_ns);
 }
@@ -22,15 +22,26 @@ void CanopenMaster::enter_step(BringUpStep step, std::int64_t now_ns) {
   bring_up_.step = step;
   bring_up_.step_started_ns = now_ns;
   bring_up_.request_sent = false;
+  bring_up_.drive_index = 0;
   if (step == BringUpStep::done) emit(MasterEventKind::bring_up_done, config_.drive_node_id, now_ns);
 }
 
 void CanopenMaster::fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t abort_code) {
-  if (abort_code != 0) {
-    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s: SDO abort 0x%08X (%s)",
-                  to_string(bring_up_.step), what, static_cast<unsigned>(abort_code), sdo_abort::text(abort_code));
+  // With several drives the text names the one that failed (drive node id).
+  char where[48];
+  const BringUpStep step = bring_up_.step;
+  const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode || step == BringUpStep::enable;
+  if (drive_count_ > 1 && per_drive) {
+    std::snprintf(where, sizeof where, "%s (drive %u)", to_string(bring_up_.step),
+                  static_cast<unsigned>(config_.drive_node(bring_up_.drive_index)));
   } else {
-    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s", to_string(bring_up_.step), what);
+    std::snprintf(where, sizeof where, "%s", to_string(bring_up_.step));
+  }
+  if (abort_code != 0) {
+    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s: SDO abort 0x%08X (%s)", where, what,
+                  static_cast<unsigned>(abort_code), sdo_abort::text(abort_code));
+  } else {
+    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s", where, what);
   }
   bring_up_.step = BringUpStep::failed;
   emit(MasterEventKind::bring_up_failed, config_.drive_node_id, now_ns);
@@ -47,19 +58,37 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
     return hb.status().alive && hb.status().state == NmtState::operational;
   };
   // An SDO step: start the transfer once, then wait for its outcome.
+  // Drive b.drive_index's SDO client: set_mode and check_mode visit the drives in turn.
+  SdoClient& sdo = drives_[b.drive_index].sdo;
   const auto sdo_step = [&](bool upload, std::uint16_t index, std::uint32_t value) -> const SdoTransfer* {
     if (!b.request_sent) {
-      b.request_sent = upload ? sdo_upload(NodeRole::drive, {index, 0}, now_ns)
-                              : sdo_download(NodeRole::drive, {index, 0}, value, 1, now_ns);
+      b.request_sent = sdo_start(NodeRef{NodeRole::drive, b.drive_index}, upload, {index, 0}, value, 1, now_ns);
       return nullptr;
     }
-    const SdoTransfer& t = drive_sdo_.transfer();
+    const SdoTransfer& t = sdo.transfer();
     return t.status == SdoStatus::pending ? nullptr : &t;
+  };
+  // Next drive within the same step, or the next step after the last drive.
+  const auto next_drive_or = [&](BringUpStep next) {
+    if (b.drive_index + 1 < drive_count_) {
+      const std::size_t following = b.drive_index + 1;
+      enter_step(b.step, now_ns);
+      b.drive_index = following;
+    } else {
+      enter_step(next, now_ns);
+    }
+  };
+  const auto all_drives = [&](auto&& predicate) {
+    for (std::size_t i = 0; i < drive_count_; ++i) {
+      if (!predicate(i)) return false;
+    }
+    return true;
   };
 
   switch (b.step) {
     case BringUpStep::wait_boot:
-      if (heard_since_step(drive_hb_) && (!config_.use_load_cell || heard_since_step(load_cell_hb_))) {
+      if (all_drives([&](std::size_t i) { return heard_since_step(drives_[i].hb); }) &&
+          (!config_.use_load_cell || heard_since_step(load_cell_hb_))) {
         enter_step(BringUpStep::set_mode, now_ns);
         return;
       }
@@ -67,50 +96,61 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
     case BringUpStep::set_mode:
       if (const SdoTransfer* t = sdo_step(false, kOdModesOfOperation, kModeCyclicSynchronousPosition)) {
         const SdoTransfer done = *t;
-        drive_sdo_.acknowledge();
+        sdo.acknowledge();
         if (done.status != SdoStatus::done) return fail_bring_up("writing 0x6060", now_ns, done.abort_code);
-        enter_step(BringUpStep::check_mode, now_ns);
+        next_drive_or(BringUpStep::check_mode);
         return;
       }
       break;
     case BringUpStep::check_mode:
       if (const SdoTransfer* t = sdo_step(true, kOdModesOfOperationDisplay, 0)) {
         const SdoTransfer done = *t;
-        drive_sdo_.acknowledge();
+        sdo.acknowledge();
         if (done.status != SdoStatus::done) return fail_bring_up("reading 0x6061", now_ns, done.abort_code);
         if (static_cast<std::int8_t>(done.value & 0xFFU) != kModeCyclicSynchronousPosition) {
           return fail_bring_up("drive does not report mode 8 (cyclic synchronous position)", now_ns);
         }
-        enter_step(BringUpStep::start_nodes, now_ns);
+        next_drive_or(BringUpStep::start_nodes);
         return;
       }
       break;
     case BringUpStep::start_nodes:
       if (!b.request_sent) {
-        send_nmt(NmtCommand::start, config_.drive_node_id);
+        for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::start, config_.drive_node(i));
         if (config_.use_load_cell) send_nmt(NmtCommand::start, config_.load_cell_node_id);
         b.request_sent = true;
-      } else if (operational(drive_hb_) && (!config_.use_load_cell || operational(load_cell_hb_))) {
-        power_.request(PowerRequest::operation_enabled);
+      } else if (all_drives([&](std::size_t i) { return operational(drives_[i].hb); }) &&
+                 (!config_.use_load_cell || operational(load_cell_hb_))) {
+        request_power(PowerRequest::operation_enabled);
         enter_step(BringUpStep::enable, now_ns);
         return;
       }
       break;
     case BringUpStep::enable:
-      if (drive_.state == Cia402State::operation_enabled) {
+      for (std::size_t i = 0; i < drive_count_; ++i) {
+        const Cia402State state = drives_[i].status.state;
+        if (state == Cia402State::fault || state == Cia402State::fault_reaction_active) {
+          request_power(PowerRequest::disabled);
+          b.drive_index = i;
+          return fail_bring_up("drive entered fault", now_ns);
+        }
+      }
+      if (all_drives([&](std::size_t i) { return drives_[i].status.state == Cia402State::operation_enabled; })) {
         enter_step(BringUpStep::done, now_ns);
         return;
-      }
-      if (drive_.state == Cia402State::fault || drive_.state == Cia402State::fault_reaction_active) {
-        power_.request(PowerRequest::disabled);
-        return fail_bring_up("drive entered fault", now_ns);
       }
       break;
     default:
       return;
   }
   if (now_ns - b.step_started_ns > config_.bring_up_step_timeout_ns) {
-    power_.request(PowerRequest::disabled);
+    request_power(PowerRequest::disabled);
+    if (b.step == BringUpStep::enable) {  // name the first drive that did not come up
+      while (b.drive_index + 1 < drive_count_ &&
+             drives_[b.drive_index].status.state == Cia402State::operation_enabled) {
+        ++b.drive_index;
+      }
+    }
     fail_bring_up(b.step == BringUpStep::wait_boot ? "no heartbeat from a node (timeout)" : "timeout", now_ns);
   }
 }

@@ -53,21 +53,31 @@ const char* to_string(RxDrop reason) {
   return "unknown";
 }
 
+std::array<CanopenMaster::DriveNode, kMaxDriveNodes> CanopenMaster::make_drives(const CanopenMasterConfig& c) {
+  static_assert(kMaxDriveNodes == 4, "list one DriveNode per possible drive");
+  return {DriveNode(c.drive_node(0), c), DriveNode(c.drive_node(1), c), DriveNode(c.drive_node(2), c),
+          DriveNode(c.drive_node(3), c)};
+}
+
+// A drive count outside 1..kMaxDriveNodes is clamped rather than thrown on: the
+// application validates its configuration before it builds the master.
 CanopenMaster::CanopenMaster(CanBus& bus, const CanopenMasterConfig& config)
     : bus_(bus),
       config_(config),
-      drive_hb_(config.drive_heartbeat_timeout_ns),
+      drive_count_(config.drive_count < 1 ? 1 : (config.drive_count > kMaxDriveNodes ? kMaxDriveNodes : config.drive_count)),
+      drives_(make_drives(config)),
       load_cell_hb_(config.load_cell_heartbeat_timeout_ns),
-      drive_sdo_(config.drive_node_id, config.sdo_timeout_ns),
       load_cell_sdo_(config.load_cell_node_id, config.sdo_timeout_ns) {}
 
-bool CanopenMaster::role_of(std::uint8_t id, NodeRole& role) const {
-  if (id == config_.drive_node_id) {
-    role = NodeRole::drive;
-    return true;
+bool CanopenMaster::node_ref(std::uint8_t id, NodeRef& node) const {
+  for (std::size_t i = 0; i < drive_count_; ++i) {
+    if (id == config_.drive_node(i)) {
+      node = NodeRef{NodeRole::drive, i};
+      return true;
+    }
   }
   if (config_.use_load_cell && id == config_.load_cell_node_id) {
-    role = NodeRole::load_cell;
+    node = NodeRef{NodeRole::load_cell, 0};
     return true;
   }
   return false;
@@ -96,17 +106,18 @@ void CanopenMaster::on_frame(const CanFrame& frame, std::int64_t now_ns) {
     default:
       return drop(RxDrop::unexpected_function);
   }
-  NodeRole role = NodeRole::drive;
-  if (!role_of(node_of(frame.id), role)) return drop(RxDrop::unknown_node);
+  NodeRef node;
+  if (!node_ref(node_of(frame.id), node)) return drop(RxDrop::unknown_node);
+  const bool is_drive = node.role == NodeRole::drive;
   switch (function) {
-    case Function::heartbeat: return on_heartbeat(frame, role, now_ns);
-    case Function::sync_or_emcy: return on_emcy(frame, role, now_ns);
+    case Function::heartbeat: return on_heartbeat(frame, node, now_ns);
+    case Function::sync_or_emcy: return on_emcy(frame, node, now_ns);
     case Function::tpdo1:
-      return role == NodeRole::drive ? on_drive_tpdo1(frame, now_ns) : on_load_cell_tpdo1(frame, now_ns);
+      return is_drive ? on_drive_tpdo1(frame, node.drive_index, now_ns) : on_load_cell_tpdo1(frame, now_ns);
     case Function::tpdo2:
-      if (role != NodeRole::drive) return drop(RxDrop::unexpected_function);
-      return on_drive_tpdo2(frame, now_ns);
-    case Function::sdo_tx: return on_sdo(frame, role, now_ns);
+      if (!is_drive) return drop(RxDrop::unexpected_function);
+      return on_drive_tpdo2(frame, node.drive_index, now_ns);
+    case Function::sdo_tx: return on_sdo(frame, node, now_ns);
     default: return drop(RxDrop::unexpected_function);
   }
 }
@@ -121,41 +132,41 @@ void CanopenMaster::on_sync(const CanFrame& frame, std::int64_t now_ns) {
   accept();
 }
 
-void CanopenMaster::on_heartbeat(const CanFrame& frame, NodeRole role, std::int64_t now_ns) {
+void CanopenMaster::on_heartbeat(const CanFrame& frame, NodeRef node, std::int64_t now_ns) {
   if (frame.dlc != 1) return drop(RxDrop::bad_length);
   NmtState state = NmtState::unknown;
   if (!decode_nmt_state(frame.data[0], state)) return drop(RxDrop::bad_value);
   accept();
-  HeartbeatMonitor& hb = role == NodeRole::drive ? drive_hb_ : load_cell_hb_;
+  HeartbeatMonitor& hb = node.role == NodeRole::drive ? drives_[node.drive_index].hb : load_cell_hb_;
   switch (hb.on_heartbeat(state, now_ns)) {
-    case HeartbeatMonitor::Change::boot_up: emit(MasterEventKind::boot_up, node_id(role), now_ns); break;
+    case HeartbeatMonitor::Change::boot_up: emit(MasterEventKind::boot_up, node_id(node), now_ns); break;
     case HeartbeatMonitor::Change::restored:
-      emit(MasterEventKind::heartbeat_restored, node_id(role), now_ns);
+      emit(MasterEventKind::heartbeat_restored, node_id(node), now_ns);
       break;
     default: break;
   }
 }
 
-void CanopenMaster::on_emcy(const CanFrame& frame, NodeRole role, std::int64_t now_ns) {
+void CanopenMaster::on_emcy(const CanFrame& frame, NodeRef node, std::int64_t now_ns) {
   EmcyMessage emcy;
   if (!decode_emcy(frame, emcy)) return drop(RxDrop::bad_length);
   accept();
-  if (role == NodeRole::drive) {
-    drive_.has_emcy = true;
-    drive_.last_emcy = emcy;
+  if (node.role == NodeRole::drive) {
+    drives_[node.drive_index].status.has_emcy = true;
+    drives_[node.drive_index].status.last_emcy = emcy;
   } else {
     load_cell_.has_emcy = true;
     load_cell_.last_emcy = emcy;
   }
   MasterEvent e;
   e.kind = MasterEventKind::emcy;
-  e.node_id = node_id(role);
+  e.node_id = node_id(node);
   e.time_ns = now_ns;
   e.emcy = emcy;
   events_.push(e);
 }
 
-void CanopenMaster::on_drive_tpdo1(const CanFrame& frame, std::int64_t now_ns) {
+void CanopenMaster::on_drive_tpdo1(const CanFrame& frame, std::size_t drive_index, std::int64_t now_ns) {
   if (frame.dlc != kDriveTpdo1Bytes) return drop(RxDrop::bad_length);
   DriveTpdo1 pdo;
   if (!decode_drive_tpdo1(frame, pdo)) return drop(RxDrop::bad_length);
@@ -165,26 +176,29 @@ void CanopenMaster::on_drive_tpdo1(const CanFrame& frame, std::int64_t now_ns) {
   const auto in_fault = [](Cia402State s) {
     return s == Cia402State::fault || s == Cia402State::fault_reaction_active;
   };
-  const bool was_fault = drive_.seen && in_fault(drive_.state);
-  drive_.seen = true;
-  drive_.statusword = pdo.statusword;
-  drive_.state = state;
-  drive_.position_counts = pdo.actual_position_counts;
-  drive_.rest_length_m = config_.spool.rest_length_from_counts(pdo.actual_position_counts);
-  drive_.position_updated_ns = now_ns;
-  if (in_fault(state) && !was_fault) emit(MasterEventKind::drive_fault, config_.drive_node_id, now_ns);
-  if (!in_fault(state) && was_fault) emit(MasterEventKind::drive_fault_cleared, config_.drive_node_id, now_ns);
+  DriveStatus& ds = drives_[drive_index].status;
+  const std::uint8_t id = config_.drive_node(drive_index);
+  const bool was_fault = ds.seen && in_fault(ds.state);
+  ds.seen = true;
+  ds.statusword = pdo.statusword;
+  ds.state = state;
+  ds.position_counts = pdo.actual_position_counts;
+  ds.rest_length_m = config_.spool.rest_length_from_counts(pdo.actual_position_counts);
+  ds.position_updated_ns = now_ns;
+  if (in_fault(state) && !was_fault) emit(MasterEventKind::drive_fault, id, now_ns);
+  if (!in_fault(state) && was_fault) emit(MasterEventKind::drive_fault_cleared, id, now_ns);
 }
 
-void CanopenMaster::on_drive_tpdo2(const CanFrame& frame, std::int64_t now_ns) {
+void CanopenMaster::on_drive_tpdo2(const CanFrame& frame, std::size_t drive_index, std::int64_t now_ns) {
   if (frame.dlc != kDriveTpdo2Bytes) return drop(RxDrop::bad_length);
   DriveTpdo2 pdo;
   if (!decode_drive_tpdo2(frame, pdo)) return drop(RxDrop::bad_length);
   accept();
-  drive_.velocity_counts_per_s = pdo.actual_velocity_counts_per_s;
-  drive_.rest_length_rate_m_per_s = config_.spool.rate_from_counts_per_s(pdo.actual_velocity_counts_per_s);
-  drive_.mode_display = pdo.mode_display;
-  drive_.velocity_updated_ns = now_ns;
+  DriveStatus& ds = drives_[drive_index].status;
+  ds.velocity_counts_per_s = pdo.actual_velocity_counts_per_s;
+  ds.rest_length_rate_m_per_s = config_.spool.rate_from_counts_per_s(pdo.actual_velocity_counts_per_s);
+  ds.mode_display = pdo.mode_display;
+  ds.velocity_updated_ns = now_ns;
 }
 
 void CanopenMaster::on_load_cell_tpdo1(const CanFrame& frame, std::int64_t now_ns) {
@@ -206,52 +220,58 @@ void CanopenMaster::on_load_cell_tpdo1(const CanFrame& frame, std::int64_t now_n
   }
 }
 
-void CanopenMaster::on_sdo(const CanFrame& frame, NodeRole role, std::int64_t now_ns) {
+void CanopenMaster::on_sdo(const CanFrame& frame, NodeRef node, std::int64_t now_ns) {
   CanFrame abort;
   bool send_abort = false;
-  switch (sdo_client(role).on_response(frame, now_ns, abort, send_abort)) {
+  switch (sdo_client(node).on_response(frame, now_ns, abort, send_abort)) {
     case SdoRx::completed:
       accept();
-      emit(MasterEventKind::sdo_finished, node_id(role), now_ns);
+      emit(MasterEventKind::sdo_finished, node_id(node), now_ns);
       break;
     case SdoRx::unexpected: drop(RxDrop::unexpected_sdo); break;
     case SdoRx::malformed:
       drop(frame.dlc != 8 ? RxDrop::bad_length : RxDrop::bad_value);
       if (send_abort) {
         bus_.send(abort);
-        emit(MasterEventKind::sdo_finished, node_id(role), now_ns);
+        emit(MasterEventKind::sdo_finished, node_id(node), now_ns);
       }
       break;
   }
 }
 
 void CanopenMaster::poll(std::int64_t now_ns) {
-  if (drive_hb_.poll(now_ns) == HeartbeatMonitor::Change::lost) {
-    emit(MasterEventKind::heartbeat_lost, config_.drive_node_id, now_ns);
+  for (std::size_t i = 0; i < drive_count_; ++i) {
+    if (drives_[i].hb.poll(now_ns) == HeartbeatMonitor::Change::lost) {
+      emit(MasterEventKind::heartbeat_lost, config_.drive_node(i), now_ns);
+    }
   }
   if (config_.use_load_cell && load_cell_hb_.poll(now_ns) == HeartbeatMonitor::Change::lost) {
     emit(MasterEventKind::heartbeat_lost, config_.load_cell_node_id, now_ns);
   }
-  for (const NodeRole role : {NodeRole::drive, NodeRole::load_cell}) {
+  const auto poll_sdo = [&](NodeRef node) {
     CanFrame abort;
-    if (sdo_client(role).poll(now_ns, abort)) {
+    if (sdo_client(node).poll(now_ns, abort)) {
       bus_.send(abort);
-      emit(MasterEventKind::sdo_finished, node_id(role), now_ns);
+      emit(MasterEventKind::sdo_finished, node_id(node), now_ns);
     }
-  }
+  };
+  for (std::size_t i = 0; i < drive_count_; ++i) poll_sdo(NodeRef{NodeRole::drive, i});
+  poll_sdo(NodeRef{NodeRole::load_cell, 0});
   step_bring_up(now_ns);
 }
 
-CanResult CanopenMaster::write_target(double rest_length_m) {
+CanResult CanopenMaster::write_target(std::size_t drive_index, double rest_length_m) {
+  if (drive_index >= drive_count_) return CanResult::invalid_frame;
+  DriveStatus& ds = drives_[drive_index].status;
   const bool finite = std::isfinite(rest_length_m);
   if (!finite) ++targets_refused_;
-  const std::uint16_t cw = power_.next_controlword(drive_.state);
-  const bool follow = finite && drive_.state == Cia402State::operation_enabled;
+  const std::uint16_t cw = drives_[drive_index].power.next_controlword(ds.state);
+  const bool follow = finite && ds.state == Cia402State::operation_enabled;
   const std::int32_t target =
-      follow ? config_.spool.counts_from_rest_length(rest_length_m) : drive_.position_counts;
-  drive_.controlword_sent = cw;
-  drive_.target_sent_counts = target;
-  return bus_.send(encode_drive_rpdo1(config_.drive_node_id, {cw, target}));
+      follow ? config_.spool.counts_from_rest_length(rest_length_m) : ds.position_counts;
+  ds.controlword_sent = cw;
+  ds.target_sent_counts = target;
+  return bus_.send(encode_drive_rpdo1(config_.drive_node(drive_index), {cw, target}));
 }
 
 CanResult CanopenMaster::send_sync() {
@@ -269,21 +289,25 @@ CanResult CanopenMaster::send_nmt(NmtCommand command, std::uint8_t id) {
   return bus_.send(encode_nmt(command, id));
 }
 
-bool CanopenMaster::sdo_upload(NodeRole node, SdoAddress address, std::int64_t now_ns) {
-  if (node == NodeRole::load_cell && !config_.use_load_cell) return false;
+bool CanopenMaster::sdo_start(NodeRef node, bool upload, SdoAddress address, std::uint32_t value,
+                              std::uint8_t size_bytes, std::int64_t now_ns) {
+  if (node.role == NodeRole::load_cell && !config_.use_load_cell) return false;
   CanFrame request;
-  if (!sdo_client(node).start_upload(address, now_ns, request)) return false;
+  SdoClient& client = sdo_client(node);
+  const bool started = upload ? client.start_upload(address, now_ns, request)
+                              : client.start_download(address, value, size_bytes, now_ns, request);
+  if (!started) return false;
   bus_.send(request);
   return true;
 }
 
+bool CanopenMaster::sdo_upload(NodeRole node, SdoAddress address, std::int64_t now_ns) {
+  return sdo_start(NodeRef{node, 0}, true, address, 0, 0, now_ns);
+}
+
 bool CanopenMaster::sdo_download(NodeRole node, SdoAddress address, std::uint32_t value, std::uint8_t size_bytes,
                                  std::int64_t now_ns) {
-  if (node == NodeRole::load_cell && !config_.use_load_cell) return false;
-  CanFrame request;
-  if (!sdo_client(node).start_download(address, value, size_bytes, now_ns, request)) return false;
-  bus_.send(request);
-  return true;
+  return sdo_start(NodeRef{node, 0}, false, address, value, size_bytes, now_ns);
 }
 
 }  // namespace tensegrity::fw::canopen

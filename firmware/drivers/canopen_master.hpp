@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// The end cap's CANopen master (CiA 301 subset) for one CiA 402 drive in cyclic
-// synchronous position mode and one load-cell node. Per control cycle the
-// application:
+// The end cap's CANopen master (CiA 301 subset) for the end cap's CiA 402 drives
+// (one per motor: a SUPERball end cap winds two cables) in cyclic synchronous
+// position mode and one load-cell node. Per control cycle the application:
 //   1. drains the bus: while (bus.receive(f, 0) == ok) master.on_frame(f, now);
 //   2. master.poll(now)              heartbeat and SDO timeouts, bring-up steps
 //   3. reads drive(), load_cell(), pop_event()
-//   4. master.write_target(length)   RPDO1: controlword + target position
+//   4. master.write_target(i, length) RPDO1 of drive i: controlword + target position
 //   5. master.send_sync()            the drive latches the target, nodes answer with TPDOs
 // (In HIL lockstep the emulator may produce SYNC instead; on_frame records it.)
 // Nothing after construction allocates or throws; every frame is checked and a
@@ -30,8 +30,15 @@ namespace tensegrity::fw::canopen {
 
 enum class NodeRole : std::uint8_t { drive, load_cell };
 
+// Matches the control core's kMaxMotorsPerEndcap: one drive per motor.
+inline constexpr std::size_t kMaxDriveNodes = 4;
+
 struct CanopenMasterConfig {
-  std::uint8_t drive_node_id = 1;
+  std::uint8_t drive_node_id = 1;  // drive 0
+  // Drives beyond drive 0, one per further motor: drive i (1 <= i < drive_count) is
+  // extra_drive_node_ids[i - 1]. drive_count is 1..kMaxDriveNodes; all ids distinct.
+  std::uint8_t drive_count = 1;
+  std::array<std::uint8_t, kMaxDriveNodes - 1> extra_drive_node_ids{};
   std::uint8_t load_cell_node_id = 2;
   bool use_load_cell = true;
   // Per node: a few producer periods (nodes here beat every 20 ms or so).
@@ -40,7 +47,11 @@ struct CanopenMasterConfig {
   std::int64_t sdo_timeout_ns = 50'000'000;
   std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
   std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
-  SpoolGeometry spool;
+  SpoolGeometry spool;  // the same spool on every drive
+
+  std::uint8_t drive_node(std::size_t index) const {
+    return index == 0 ? drive_node_id : extra_drive_node_ids[index - 1];
+  }
 };
 
 struct DriveStatus {
@@ -122,35 +133,46 @@ class CanopenMaster {
   void on_frame(const CanFrame& frame, std::int64_t now_ns);
   void poll(std::int64_t now_ns);
 
-  // Sends RPDO1. The target is the commanded rest length unless the drive is not
-  // in operation enabled: then it is the drive's own position, so enabling never
-  // jumps (seed the motor loop from drive().rest_length_m before enabling). A
-  // non-finite length is refused and the drive holds position.
-  CanResult write_target(double rest_length_m);
+  // Sends RPDO1 of drive `drive_index` (drive 0 without an index). The target is
+  // the commanded rest length unless the drive is not in operation enabled: then
+  // it is the drive's own position, so enabling never jumps (seed the motor loop
+  // from drive(i).rest_length_m before enabling). A non-finite length is refused
+  // and the drive holds position. An index >= drive_count() sends nothing.
+  CanResult write_target(double rest_length_m) { return write_target(0, rest_length_m); }
+  CanResult write_target(std::size_t drive_index, double rest_length_m);
   CanResult send_sync();
   CanResult send_nmt(NmtCommand command, std::uint8_t node_id);  // node 0: all
 
-  void request_power(PowerRequest request) { power_.request(request); }
-  void request_fault_reset() { power_.request_fault_reset(); }
-  PowerRequest power_request() const { return power_.requested(); }
+  // Power requests apply to every drive of the end cap: they act together.
+  void request_power(PowerRequest request) {
+    for (std::size_t i = 0; i < drive_count_; ++i) drives_[i].power.request(request);
+  }
+  void request_fault_reset() {
+    for (std::size_t i = 0; i < drive_count_; ++i) drives_[i].power.request_fault_reset();
+  }
+  PowerRequest power_request() const { return drives_[0].power.requested(); }
 
-  // Reset communication, then set CSP, verify it, start the nodes, enable the drive.
+  // Reset communication, then set CSP on each drive, verify it, start the nodes,
+  // enable the drives.
   void start_bring_up(std::int64_t now_ns);
   BringUpStep bring_up_step() const { return bring_up_.step; }
   const char* bring_up_failure() const { return bring_up_.failure.data(); }
 
   // One expedited transfer per node at a time; false when busy or unknown node.
+  // NodeRole::drive is drive 0.
   bool sdo_upload(NodeRole node, SdoAddress address, std::int64_t now_ns);
   bool sdo_download(NodeRole node, SdoAddress address, std::uint32_t value, std::uint8_t size_bytes,
                     std::int64_t now_ns);
   const SdoTransfer& sdo_transfer(NodeRole node) const { return sdo_client(node).transfer(); }
   void sdo_acknowledge(NodeRole node) { sdo_client(node).acknowledge(); }
 
-  const DriveStatus& drive() const { return drive_; }
+  std::size_t drive_count() const { return drive_count_; }
+  const DriveStatus& drive(std::size_t index = 0) const { return drives_[index].status; }
   const LoadCellStatus& load_cell() const { return load_cell_; }
   const HeartbeatStatus& heartbeat(NodeRole node) const {
-    return node == NodeRole::drive ? drive_hb_.status() : load_cell_hb_.status();
+    return node == NodeRole::drive ? drives_[0].hb.status() : load_cell_hb_.status();
   }
+  const HeartbeatStatus& drive_heartbeat(std::size_t index) const { return drives_[index].hb.status(); }
   const SyncStatus& sync() const { return sync_; }
   bool pop_event(MasterEvent& event) { return events_.pop(event); }
   std::uint64_t events_lost() const { return events_.overflows(); }
@@ -164,27 +186,46 @@ class CanopenMaster {
     BringUpStep step = BringUpStep::idle;
     std::int64_t step_started_ns = 0;
     bool request_sent = false;
+    std::size_t drive_index = 0;  // set_mode / check_mode go through the drives in turn
     std::array<char, 128> failure{};
   };
+  // Everything the master keeps per drive node.
+  struct DriveNode {
+    DriveNode(std::uint8_t id, const CanopenMasterConfig& c)
+        : hb(c.drive_heartbeat_timeout_ns), sdo(id, c.sdo_timeout_ns) {}
+    HeartbeatMonitor hb;
+    SdoClient sdo;
+    Cia402PowerControl power;
+    DriveStatus status;
+  };
+  // A node on the bus as the master knows it: a drive (with its index) or the load cell.
+  struct NodeRef {
+    NodeRole role = NodeRole::drive;
+    std::size_t drive_index = 0;
+  };
 
-  SdoClient& sdo_client(NodeRole node) { return node == NodeRole::drive ? drive_sdo_ : load_cell_sdo_; }
+  static std::array<DriveNode, kMaxDriveNodes> make_drives(const CanopenMasterConfig& config);
+  SdoClient& sdo_client(NodeRef node) { return node.role == NodeRole::drive ? drives_[node.drive_index].sdo : load_cell_sdo_; }
   const SdoClient& sdo_client(NodeRole node) const {
-    return node == NodeRole::drive ? drive_sdo_ : load_cell_sdo_;
+    return node == NodeRole::drive ? drives_[0].sdo : load_cell_sdo_;
   }
-  bool role_of(std::uint8_t node_id, NodeRole& role) const;
-  std::uint8_t node_id(NodeRole role) const {
-    return role == NodeRole::drive ? config_.drive_node_id : config_.load_cell_node_id;
+  SdoClient& sdo_client(NodeRole node) { return sdo_client(NodeRef{node, 0}); }
+  bool node_ref(std::uint8_t node_id, NodeRef& node) const;
+  std::uint8_t node_id(NodeRef node) const {
+    return node.role == NodeRole::drive ? config_.drive_node(node.drive_index) : config_.load_cell_node_id;
   }
   void emit(MasterEventKind kind, std::uint8_t node_id, std::int64_t now_ns);
   void drop(RxDrop reason) { drops_.count(reason); }
   void accept() { ++frames_accepted_; }
+  bool sdo_start(NodeRef node, bool upload, SdoAddress address, std::uint32_t value, std::uint8_t size_bytes,
+                 std::int64_t now_ns);
 
-  void on_heartbeat(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
-  void on_emcy(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
-  void on_drive_tpdo1(const CanFrame& frame, std::int64_t now_ns);
-  void on_drive_tpdo2(const CanFrame& frame, std::int64_t now_ns);
+  void on_heartbeat(const CanFrame& frame, NodeRef node, std::int64_t now_ns);
+  void on_emcy(const CanFrame& frame, NodeRef node, std::int64_t now_ns);
+  void on_drive_tpdo1(const CanFrame& frame, std::size_t drive_index, std::int64_t now_ns);
+  void on_drive_tpdo2(const CanFrame& frame, std::size_t drive_index, std::int64_t now_ns);
   void on_load_cell_tpdo1(const CanFrame& frame, std::int64_t now_ns);
-  void on_sdo(const CanFrame& frame, NodeRole role, std::int64_t now_ns);
+  void on_sdo(const CanFrame& frame, NodeRef node, std::int64_t now_ns);
   void on_sync(const CanFrame& frame, std::int64_t now_ns);
 
   void step_bring_up(std::int64_t now_ns);
@@ -193,12 +234,10 @@ class CanopenMaster {
 
   CanBus& bus_;
   CanopenMasterConfig config_;
-  HeartbeatMonitor drive_hb_;
+  std::size_t drive_count_;
+  std::array<DriveNode, kMaxDriveNodes> drives_;
   HeartbeatMonitor load_cell_hb_;
-  SdoClient drive_sdo_;
   SdoClient load_cell_sdo_;
-  Cia402PowerControl power_;
-  DriveStatus drive_;
   LoadCellStatus load_cell_;
   SyncStatus sync_;
   std::uint8_t next_sync_counter_ = 1;

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: Apache-2.0
+// The end cap program's configuration file (format "tensegrity-endcap/1"), parsed
+// once at start-up. Every error names the file and the field, so a typo in the
+// field is found from the log line alone. Unknown fields are errors for the same
+// reason: a misspelt limit must not silently fall back to its default.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include "firmware/core/limits.hpp"
+#include "firmware/drivers/spool_geometry.hpp"
+
+namespace tensegrity::fw::app {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class LoopMode : std::uint8_t {
+  realtime,  // own absolute-deadline timer at rate_hz; the end cap sends SYNC
+  lockstep,  // one cycle per SYNC received from the bus (the HIL owns time)
+};
+
+const char* to_string(LoopMode mode);
+
+struct EndcapAppConfig {
+  int endcap_id = 0;  // 0..11, from --id (not in the file: one file may serve a test rig)
+  std::string bus;    // "socketcan:can0" | "udp:HOST:PORT[,bind=HOST:PORT]"
+  // One drive per motor, in motor order; the load cell's channel m measures motor m.
+  std::uint32_t motor_count = 2;
+  std::array<std::uint8_t, core::kMaxMotorsPerEndcap> drive_node_ids{1, 3, 0, 0};
+  std::uint8_t load_cell_node_id = 2;
+  bool use_load_cell = true;
+  double spool_radius_m = 0.01;
+  double counts_per_rev = 4096.0 * 109.0;
+  core::MotorLimits limits{};
+  double initial_rest_length_m = 0.95;  // rest length at drive count 0 (homing)
+  std::filesystem::path storage_dir = "/var/lib/tensegrity/endcap";
+  double loop_rate_hz = 1000.0;
+  LoopMode mode = LoopMode::realtime;
+  double drive_heartbeat_timeout_s = 0.1;
+  double load_cell_heartbeat_timeout_s = 0.1;
+  // No fresh load-cell sample (new sequence number, channel valid) for this long
+  // trips sensor_timeout; a few SYNC periods.
+  double load_cell_sample_timeout_s = 0.02;
+  bool start_on_boot = false;
+  double stats_log_period_s = 10.0;
+
+  std::int64_t period_ns() const;
+  SpoolGeometry spool() const { return SpoolGeometry{spool_radius_m, counts_per_rev, initial_rest_length_m}; }
+};
+
+// `source` names the text in errors (the file path).
+EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source = "config");
+EndcapAppConfig load_config(const std::filesystem::path& path, int endcap_id);
+
+}  // namespace tensegrity::fw::app

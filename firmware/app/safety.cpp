@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "firmware/app/safety.hpp"
+
+namespace tensegrity::fw::app {
+
+using canopen::Cia402State;
+using canopen::MasterEventKind;
+using core::FaultCause;
+
+bool SafetyMonitor::is_drive(std::uint8_t node_id, const canopen::CanopenMaster& master) const {
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    if (master.config().drive_node(i) == node_id) return true;
+  }
+  return false;
+}
+
+FaultCause SafetyMonitor::on_event(const canopen::MasterEvent& e, const canopen::CanopenMaster& master) {
+  const bool drive = is_drive(e.node_id, master);
+  switch (e.kind) {
+    case MasterEventKind::emcy:
+      // Error code 0 is "error reset / no error": a node announcing recovery.
+      if (drive && e.emcy.error_code != 0) return FaultCause::drive_fault;
+      if (!drive && e.emcy.error_code != 0) return FaultCause::sensor_timeout;
+      return FaultCause::none;
+    case MasterEventKind::drive_fault: return FaultCause::drive_fault;
+    case MasterEventKind::heartbeat_lost: return drive ? FaultCause::drive_lost : FaultCause::sensor_timeout;
+    default: return FaultCause::none;
+  }
+}
+
+FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64_t now_ns, bool armed) {
+  // Freshness is tracked also while disarmed so arming does not trip on a stale clock.
+  const canopen::LoadCellStatus& lc = master.load_cell();
+  const bool new_sample = lc.seen && (!sequence_seen_ || lc.sequence != last_sequence_);
+  if (new_sample) {
+    sequence_seen_ = true;
+    last_sequence_ = lc.sequence;
+    for (std::uint32_t ch = 0; ch < 2; ++ch) {
+      if (lc.valid[ch]) fresh_ns_[ch] = now_ns;
+    }
+  }
+  if (armed && !was_armed_) {
+    // The sample timeout runs from arming at the earliest.
+    for (std::int64_t& t : fresh_ns_) t = t > now_ns ? t : now_ns;
+  }
+  was_armed_ = armed;
+  if (!armed) return FaultCause::none;
+
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    const Cia402State s = master.drive(i).state;
+    if (s == Cia402State::fault || s == Cia402State::fault_reaction_active) return FaultCause::drive_fault;
+  }
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    if (!master.drive_heartbeat(i).alive) return FaultCause::drive_lost;
+  }
+  if (config_.use_load_cell) {
+    if (!master.heartbeat(canopen::NodeRole::load_cell).alive) return FaultCause::sensor_timeout;
+    for (std::uint32_t ch = 0; ch < config_.motor_count && ch < 2; ++ch) {
+      if (now_ns - fresh_ns_[ch] > config_.load_cell_sample_timeout_ns) return FaultCause::sensor_timeout;
+    }
+  }
+  return FaultCause::none;
+}
+
+}  // namespace tensegrity::fw::app

@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: Apache-2.0
+// Config and policy-file errors name the field, so the log line alone says what to fix.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "firmware/app/config.hpp"
+#include "firmware/app/policy_file.hpp"
+
+namespace tensegrity::fw::app {
+namespace {
+
+using ::testing::HasSubstr;
+using json = nlohmann::json;
+
+json example() {
+  return json::parse(R"({
+    "format": "tensegrity-endcap/1",
+    "bus": "udp:127.0.0.1:47000,bind=127.0.0.1:47001",
+    "nodes": {"drives": [1, 3], "load_cell": 2},
+    "spool": {"radius_m": 0.01, "counts_per_rev": 446464},
+    "limits": {"min_rest_length_m": 0.6, "max_rest_length_m": 1.1, "speed_m_per_s": 0.2,
+               "cutoff_tension_n": 400, "hard_limit_tension_n": 500},
+    "initial_rest_length_m": 0.95,
+    "storage_dir": "/tmp/endcap",
+    "loop": {"rate_hz": 500, "mode": "lockstep"}
+  })");
+}
+
+std::string error_of(const json& doc, int id = 3) {
+  try {
+    parse_config(doc.dump(), id, "endcap.json");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(EndcapConfig, ParsesAFullConfig) {
+  const EndcapAppConfig c = parse_config(example().dump(), 3);
+  EXPECT_EQ(c.endcap_id, 3);
+  EXPECT_EQ(c.motor_count, 2U);
+  EXPECT_EQ(c.drive_node_ids[1], 3);
+  EXPECT_EQ(c.load_cell_node_id, 2);
+  EXPECT_EQ(c.mode, LoopMode::lockstep);
+  EXPECT_EQ(c.period_ns(), 2'000'000);
+  EXPECT_DOUBLE_EQ(c.limits.hard_limit_tension_n, 500.0);
+  EXPECT_FALSE(c.start_on_boot);
+}
+
+TEST(EndcapConfig, TheShippedExampleParses) {
+  const EndcapAppConfig c = load_config(ENDCAP_EXAMPLE_CONFIG, 0);
+  EXPECT_EQ(c.mode, LoopMode::realtime);
+  EXPECT_EQ(c.loop_rate_hz, 1000.0);
+}
+
+TEST(EndcapConfig, ErrorsNameTheField) {
+  json j = example();
+  j.erase("bus");
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: bus: missing"));
+
+  j = example();
+  j["bus"] = "can0";
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: bus: "));
+
+  j = example();
+  j["loop"]["mode"] = "fast";
+  EXPECT_THAT(error_of(j), HasSubstr("loop.mode: must be \"realtime\" or \"lockstep\""));
+
+  j = example();
+  j["limits"]["max_rest_length_m"] = 0.5;
+  EXPECT_THAT(error_of(j), HasSubstr("limits.max_rest_length_m: must be above min_rest_length_m"));
+
+  j = example();
+  j["limits"]["speed_m_per_s"] = "fast";
+  EXPECT_THAT(error_of(j), HasSubstr("limits.speed_m_per_s: must be a number"));
+
+  j = example();
+  j["limits"]["hard_limit_n"] = 500;  // misspelt: must not fall back to a default silently
+  EXPECT_THAT(error_of(j), HasSubstr("limits.hard_limit_n: unknown field"));
+
+  j = example();
+  j["nodes"]["drives"] = {1, 1};
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.drives[1]: node id used twice"));
+
+  j = example();
+  j["nodes"]["load_cell"] = 200;
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.load_cell: must be a CANopen node id 1..127"));
+
+  j = example();
+  j["spool"].erase("radius_m");
+  EXPECT_THAT(error_of(j), HasSubstr("spool.radius_m: missing"));
+
+  j = example();
+  j["initial_rest_length_m"] = 2.0;
+  EXPECT_THAT(error_of(j), HasSubstr("initial_rest_length_m: must lie within"));
+
+  j = example();
+  j["timeouts"] = {{"load_cell_sample_s", 0.001}};
+  EXPECT_THAT(error_of(j), HasSubstr("timeouts.load_cell_sample_s"));
+
+  EXPECT_THAT(error_of(example(), 12), HasSubstr("--id"));
+  EXPECT_THAT(error_of(json::parse(R"({"format": "tensegrity-endcap/2"})")), HasSubstr("format"));
+}
+
+std::string policy_json(double value_for_cable_5) {
+  json cables = json::array();
+  for (int c = 0; c < 24; ++c) {
+    cables.push_back({{"cable", c}, {"owner", c / 2}, {"rest_lengths_m", {0.9, c == 5 ? value_for_cable_5 : 1.0}}});
+  }
+  return json{{"format", "tensegrity-policy/1"}, {"robot", "superball"}, {"period_s", 1.2}, {"complexity", 2},
+              {"cables", cables}}
+      .dump();
+}
+
+TEST(PolicyFile, TakesThisEndcapsCablesInIndexOrder) {
+  const core::EndcapTable t = endcap_table_from_policy(policy_json(0.8), 2, 2, core::MotorLimits{});
+  EXPECT_EQ(t.motor_count, 2U);
+  EXPECT_EQ(t.complexity, 2U);
+  EXPECT_DOUBLE_EQ(t.period_s, 1.2);
+  EXPECT_DOUBLE_EQ(t.rest_length_m[0][1], 1.0);  // cable 4
+  EXPECT_DOUBLE_EQ(t.rest_length_m[1][1], 0.8);  // cable 5
+}
+
+TEST(PolicyFile, ErrorsNameTheField) {
+  const auto error = [](const std::string& text, int id) {
+    try {
+      endcap_table_from_policy(text, id, 2, core::MotorLimits{}, "p.json");
+    } catch (const PolicyFileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(error(policy_json(3.0), 2), HasSubstr("p.json: cables[5].rest_lengths_m[1]: 3 m is outside"));
+  EXPECT_EQ(error(policy_json(3.0), 3), "(no error)") << "another end cap's cable is not ours to check";
+  EXPECT_THAT(error(R"({"format": "tensegrity-policy/1", "period_s": 1, "complexity": 2, "cables": []})", 0),
+              HasSubstr("cables: end cap 0 owns 0 cables"));
+  EXPECT_THAT(error(R"({"format": "x"})", 0), HasSubstr("p.json: format"));
+  EXPECT_THAT(error("{", 0), HasSubstr("not valid JSON"));
+}
+
+}  // namespace
+}  // namespace tensegrity::fw::app

@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: Apache-2.0
+// End to end: the real `endcap` program on a udp: bus against scripted devices in
+// this process, in lockstep. This test plays the HIL: it sends SYNC, relays the
+// end cap's frames to the devices and their answers back, and watches the drive
+// targets follow the policy given with --policy and --start-on-boot.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "firmware/drivers/pdo_codec.hpp"
+#include "firmware/drivers/spool_geometry.hpp"
+#include "firmware/hal/udp_can_bus.hpp"
+#include "tests/firmware/drivers/sim_devices.hpp"
+
+extern char** environ;
+
+namespace tensegrity::fw {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+std::uint16_t free_udp_port() {
+  std::string error;
+  auto probe = UdpCanBus::open({{"127.0.0.1", 9}, {"127.0.0.1", 0}}, error);
+  return probe ? probe->local_port() : 0;  // closed again here; the race is harmless on loopback
+}
+
+class ChildProcess {
+ public:
+  explicit ChildProcess(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+  }
+  ~ChildProcess() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  pid_t pid() const { return pid_; }
+  // SIGTERM, then wait up to `timeout`; -1 if it had to be killed.
+  int terminate(std::chrono::milliseconds timeout) {
+    ::kill(pid_, SIGTERM);
+    const auto give_up = Clock::now() + timeout;
+    int status = 0;
+    while (Clock::now() < give_up) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return -1;
+  }
+  bool exited_early() {
+    int status = 0;
+    return ::waitpid(pid_, &status, WNOHANG) == pid_ ? (pid_ = -1, true) : false;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
+  const fs::path dir = fs::temp_directory_path() / ("endcap_e2e_" + std::to_string(std::random_device{}()));
+  fs::create_directories(dir);
+  const std::uint16_t endcap_port = free_udp_port();
+  ASSERT_NE(endcap_port, 0);
+  std::string error;
+  auto bus = UdpCanBus::open({{"127.0.0.1", endcap_port}, {"127.0.0.1", 0}}, error);
+  ASSERT_TRUE(bus) << error;
+
+  // End cap 2 owns cables 4 and 5: square waves in opposite phase.
+  json cables = json::array();
+  for (int c = 0; c < 24; ++c) {
+    const bool odd = c % 2 == 1;
+    cables.push_back({{"cable", c}, {"owner", c / 2}, {"rest_lengths_m", {odd ? 1.0 : 0.9, odd ? 0.9 : 1.0}}});
+  }
+  std::ofstream(dir / "policy.json") << json{{"format", "tensegrity-policy/1"}, {"robot", "superball"},
+                                             {"period_s", 0.4}, {"complexity", 2}, {"cables", cables}}
+                                            .dump();
+  const json config = {
+      {"format", "tensegrity-endcap/1"},
+      {"bus", "udp:127.0.0.1:" + std::to_string(bus->local_port()) + ",bind=127.0.0.1:" + std::to_string(endcap_port)},
+      {"nodes", {{"drives", {3, 5}}, {"load_cell", 4}}},
+      {"spool", {{"radius_m", 0.01}, {"counts_per_rev", 446464}}},
+      {"limits",
+       {{"min_rest_length_m", 0.6}, {"max_rest_length_m", 1.1}, {"speed_m_per_s", 0.2}, {"cutoff_tension_n", 400},
+        {"hard_limit_tension_n", 500}}},
+      {"initial_rest_length_m", 0.95},
+      {"storage_dir", (dir / "store").string()},
+      {"loop", {{"rate_hz", 1000}, {"mode", "lockstep"}}},
+      {"timeouts", {{"drive_heartbeat_s", 0.5}, {"load_cell_heartbeat_s", 0.5}, {"load_cell_sample_s", 0.1}}},
+  };
+  std::ofstream(dir / "endcap.json") << config.dump(2);
+
+  ChildProcess child({ENDCAP_BINARY, "--id", "2", "--config", (dir / "endcap.json").string(), "--policy",
+                      (dir / "policy.json").string(), "--start-on-boot", "--stats-json",
+                      (dir / "stats.json").string()});
+  ASSERT_GT(child.pid(), 0);
+
+  sim::SimCia402Drive drive0(3);
+  sim::SimCia402Drive drive1(5);
+  sim::SimLoadCell load_cell(4);
+  load_cell.sample.tension_mn = {100'000, 100'000};
+  sim::SimNode* devices[] = {&drive0, &drive1, &load_cell};
+  sim::FrameOut out;
+  const auto t0 = Clock::now();
+  const auto now_ns = [&] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+  };
+  const auto flush = [&] {
+    for (const CanFrame& f : out) bus->send(f);
+    out.clear();
+  };
+  // The devices boot once the end cap is listening; its bring-up resets them anyway.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (sim::SimNode* d : devices) d->boot(now_ns(), out);
+  flush();
+
+  const SpoolGeometry spool{0.01, 446464.0, 0.95};
+  std::int32_t min0 = 0, max0 = 0, min1 = 0, max1 = 0;
+  // A square wave through a rate limiter is a triangle: count its turning points.
+  struct Turns {
+    std::int32_t last = 0;
+    int direction = 0;
+    int turns = 0;
+    void add(std::int32_t v) {
+      const int d = v > last ? 1 : (v < last ? -1 : 0);
+      if (d != 0 && direction != 0 && d != direction) ++turns;
+      if (d != 0) direction = d;
+      last = v;
+    }
+  } turns0, turns1;
+  std::uint64_t rpdos = 0;
+  const auto deadline = t0 + std::chrono::seconds(7);
+  bool enough = false;
+  while (Clock::now() < deadline && !enough) {
+    ASSERT_FALSE(child.exited_early()) << "endcap exited; see its stderr above";
+    // One HIL tick: device heartbeats, SYNC to everyone, then relay until quiet.
+    for (sim::SimNode* d : devices) d->tick(now_ns(), out);
+    const CanFrame sync = canopen::encode_sync();
+    for (sim::SimNode* d : devices) d->on_frame(sync, now_ns(), out);
+    bus->send(sync);
+    flush();
+    const auto tick_end = Clock::now() + std::chrono::milliseconds(1);
+    CanFrame f;
+    while (Clock::now() < tick_end) {
+      if (bus->receive(f, 200'000) != CanResult::ok) continue;
+      if ((f.id & 0x780U) == 0x200U) ++rpdos;
+      for (sim::SimNode* d : devices) d->on_frame(f, now_ns(), out);
+      flush();
+    }
+    if (drive0.state() == canopen::Cia402State::operation_enabled) {
+      min0 = std::min(min0, drive0.target_counts());
+      max0 = std::max(max0, drive0.target_counts());
+      min1 = std::min(min1, drive1.target_counts());
+      max1 = std::max(max1, drive1.target_counts());
+      turns0.add(drive0.target_counts());
+      turns1.add(drive1.target_counts());
+    }
+    // From 0.95 m each motor moves 4 cm (0.2 m/s for half of the 0.4 s period) one
+    // way, then back, in opposite directions: the table is playing.
+    const std::int32_t three_cm = spool.counts_from_rest_length(0.92);
+    enough = max0 >= three_cm && -min1 >= three_cm && turns0.turns >= 2 && turns1.turns >= 2;
+  }
+  EXPECT_TRUE(enough) << "drive 0 counts [" << min0 << ", " << max0 << "], drive 1 [" << min1 << ", " << max1
+                      << "], turns " << turns0.turns << "/" << turns1.turns << ", RPDOs seen " << rpdos;
+  EXPECT_EQ(drive1.state(), canopen::Cia402State::operation_enabled);
+  EXPECT_EQ(drive0.mode(), canopen::kModeCyclicSynchronousPosition);
+  // Never beyond the table's range (0.9..1.0 m), whatever the rate limiter did.
+  EXPECT_LE(max0, spool.counts_from_rest_length(0.9) + 1);
+  EXPECT_GE(min1, spool.counts_from_rest_length(1.0) - 1);
+
+  EXPECT_EQ(child.terminate(std::chrono::seconds(2)), 0);
+  std::ifstream stats_file(dir / "stats.json");
+  ASSERT_TRUE(stats_file) << "--stats-json written at exit";
+  const json stats = json::parse(stats_file);
+  EXPECT_GT(stats["cycles"].get<std::uint64_t>(), 100U);
+  EXPECT_EQ(stats["cycles"].get<std::uint64_t>(), stats["syncs_received"].get<std::uint64_t>())
+      << "lockstep: one cycle per SYNC";
+  EXPECT_EQ(stats["fault"], "none");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace tensegrity::fw
