@@ -78,6 +78,7 @@ void add_bench_command(CLI::App& app) {
   sim_cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
   sim_cmd->add_flag("--json", args->json, "Print one JSON object");
   sim_cmd->callback([args] { run_bench_sim(*args); });
+  add_bench_evolve_command(*bench);
 }
 
 }  // namespace tensegrity::cli

@@ -19,5 +19,8 @@ class CommandError : public std::runtime_error {
 
 void add_sim_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_evolve_command(CLI::App& app);
+// `bench evolve`, added by add_bench_command.
+void add_bench_evolve_command(CLI::App& bench);
 
 }  // namespace tensegrity::cli

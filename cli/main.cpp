@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "tensegrity 0.1.0");
   tensegrity::cli::add_sim_command(app);
   tensegrity::cli::add_bench_command(app);
+  tensegrity::cli::add_evolve_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -47,11 +47,19 @@ Eigen::Vector3d axis_of(const dReal* R) { return {R[2], R[6], R[10]}; }
 struct Model::Ode {
   dWorldID world = nullptr;
   dJointGroupID contacts = nullptr;
+  // ODE's default stepping "threading" implementation is one process-wide object
+  // with fake (non-atomic) locks: two worlds stepped on two threads corrupt it. A
+  // self-threaded implementation per world makes worlds independent.
+  dThreadingImplementationID threading = nullptr;
   std::vector<dBodyID> bodies;
   std::vector<Eigen::Vector3d> inertia_diag;  // body frame, kg m^2
   ~Ode() {
     if (contacts != nullptr) dJointGroupDestroy(contacts);
-    if (world != nullptr) dWorldDestroy(world);
+    if (world != nullptr) {
+      dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
+      dWorldDestroy(world);
+    }
+    if (threading != nullptr) dThreadingFreeImplementation(threading);
   }
 };
 
@@ -59,6 +67,9 @@ Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
   init_ode_for_this_thread();
   ode_->world = dWorldCreate();
+  ode_->threading = dThreadingAllocateSelfThreadedImplementation();
+  dWorldSetStepThreadingImplementation(ode_->world, dThreadingImplementationGetFunctions(ode_->threading),
+                                       ode_->threading);
   ode_->contacts = dJointGroupCreate(0);
   dWorldSetAutoDisableFlag(ode_->world, 0);
   set_gravity_enabled(true);

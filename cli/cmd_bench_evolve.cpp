@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity bench evolve`: episodes per second during a short real evolution (the
+// paper's defaults, physics on a thread pool), per core, and the speed-up over one
+// thread. Also checks on the way that both runs gave the same curve.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "cli/episode_json.hpp"
+#include "sim/evolve/curve_csv.hpp"
+#include "sim/evolve/driver.hpp"
+#include "sim/evolve/episode_evaluator.hpp"
+
+namespace tensegrity::cli {
+namespace {
+
+struct BenchEvolveArgs {
+  std::string robot;
+  std::int64_t episodes = 100;
+  int threads = 0;
+  double duration_s = 60.0;
+  bool json = false;
+};
+
+struct Timed {
+  double wall_s = 0.0;
+  double episodes_per_s = 0.0;
+  std::string curve;
+};
+
+Timed time_run(const sim::Robot& robot, const sim::evolve::EvolveConfig& config, int threads) {
+  auto evaluator = sim::evolve::make_episode_evaluator(robot, config, threads);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto result = sim::evolve::drive(config, *evaluator, {});
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return Timed{wall, static_cast<double>(result.evolution.episodes()) / wall,
+               sim::evolve::curve_csv(result.evolution.curve())};
+}
+
+void run_bench_evolve(const BenchEvolveArgs& args) {
+  const sim::Robot robot = load_robot_arg(args.robot);
+  const unsigned hw = std::thread::hardware_concurrency();
+  const int threads = args.threads > 0 ? args.threads : (hw == 0 ? 1 : static_cast<int>(hw));
+  sim::evolve::EvolveConfig config;
+  config.episodes = args.episodes;
+  config.cables = robot.cable_count();
+  config.min_rest_length_m = robot.motor.min_rest_length_m;
+  config.max_rest_length_m = robot.motor.max_rest_length_m;
+  config.duration_s = args.duration_s;
+  config.robot_name = robot.name;
+  config.robot_hash = robot.hash;
+  // The settled start is computed once per process; keep it out of the timing.
+  (void)sim::settled_state(robot, robot.time_step_s);
+
+  const Timed many = time_run(robot, config, threads);
+  Timed one;
+  if (threads > 1) one = time_run(robot, config, 1);
+  const double per_core = many.episodes_per_s / threads;
+  const bool identical = threads == 1 || one.curve == many.curve;
+  if (args.json) {
+    nlohmann::json j = {{"benchmark", "evolve"},
+                        {"episodes", args.episodes},
+                        {"duration_s", args.duration_s},
+                        {"threads", threads},
+                        {"wall_s", many.wall_s},
+                        {"episodes_per_s", many.episodes_per_s},
+                        {"episodes_per_s_per_core", per_core}};
+    if (threads > 1) {
+      j["one_thread_episodes_per_s"] = one.episodes_per_s;
+      j["speedup_over_one_thread"] = many.episodes_per_s / one.episodes_per_s;
+      j["parallel_efficiency"] = many.episodes_per_s / one.episodes_per_s / threads;
+      j["identical_to_one_thread"] = identical;
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("bench evolve: %lld episodes of %.0f s (teams of 50, historical), %d threads\n",
+                static_cast<long long>(args.episodes), args.duration_s, threads);
+    std::printf("  %.2f episodes/s, %.2f per core, %.1f s wall\n", many.episodes_per_s, per_core, many.wall_s);
+    if (threads > 1) {
+      std::printf("  1 thread: %.2f episodes/s; speed-up %.2fx (efficiency %.0f%%); same curve: %s\n",
+                  one.episodes_per_s, many.episodes_per_s / one.episodes_per_s,
+                  100.0 * many.episodes_per_s / one.episodes_per_s / threads, identical ? "yes" : "NO");
+    }
+  }
+  if (!identical) throw CommandError(1, "bench evolve: the curve depends on the thread count");
+}
+
+}  // namespace
+
+void add_bench_evolve_command(CLI::App& bench) {
+  auto args = std::make_shared<BenchEvolveArgs>();
+  CLI::App* cmd = bench.add_subcommand("evolve", "Episodes per second during evolution, per core and vs one thread");
+  cmd->add_option("--robot", args->robot, "Robot description")->check(CLI::ExistingFile);
+  cmd->add_option("--episodes", args->episodes, "Episodes to run (50 per generation)")->capture_default_str()->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000}));
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  cmd->add_flag("--json", args->json, "Print one JSON object");
+  cmd->callback([args] { run_bench_evolve(*args); });
+}
+
+}  // namespace tensegrity::cli

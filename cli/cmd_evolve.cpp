@@ -1,0 +1,178 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity evolve`: cooperative coevolution of a policy on the model (paper,
+// Algorithm 1), checkpointed after every generation, resumable after any kill.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "cli/episode_json.hpp"
+#include "cli/evolve_progress.hpp"
+#include "sim/evolve/checkpoint.hpp"
+#include "sim/evolve/driver.hpp"
+#include "sim/evolve/episode_evaluator.hpp"
+
+namespace tensegrity::cli {
+namespace {
+
+struct EvolveArgs {
+  double period_s = 4.0;
+  int complexity = 5;
+  std::string method = "historical";
+  std::int64_t episodes = 5000;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  std::string checkpoint;
+  bool resume = false;
+  std::string robot;
+  int population = 10;
+  int teams = 50;
+  int replace = 5;
+  double sigma_m = 0.05;
+  double duration_s = 60.0;
+  std::string out;
+  std::string log;
+  bool json = false;
+};
+
+int default_threads() {
+  const unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : static_cast<int>(n);
+}
+
+void run_evolve(const EvolveArgs& args) {
+  const sim::Robot robot = load_robot_arg(args.robot);
+  sim::evolve::EvolveConfig config;
+  try {
+    config.method = sim::evolve::parse_fitness_method(args.method);
+  } catch (const sim::evolve::ConfigError& e) {
+    throw CommandError(2, e.what());
+  }
+  config.population = args.population;
+  config.teams = args.teams;
+  config.replace = args.replace;
+  config.sigma_m = args.sigma_m;
+  config.seed = args.seed;
+  config.episodes = args.episodes;
+  config.cables = robot.cable_count();
+  config.complexity = args.complexity;
+  config.min_rest_length_m = robot.motor.min_rest_length_m;
+  config.max_rest_length_m = robot.motor.max_rest_length_m;
+  config.period_s = args.period_s;
+  config.duration_s = args.duration_s;
+  config.robot_name = robot.name;
+  config.robot_hash = robot.hash;
+  try {
+    sim::evolve::validate(config);
+  } catch (const sim::evolve::ConfigError& e) {
+    throw CommandError(2, e.what());
+  }
+
+  // Hours of evolution must not end in "cannot write": make the output's directory now.
+  const std::filesystem::path out_path(args.out);
+  if (out_path.has_parent_path()) std::filesystem::create_directories(out_path.parent_path());
+
+  const int threads = args.threads > 0 ? args.threads : default_threads();
+  auto evaluator = sim::evolve::make_episode_evaluator(robot, config, threads);
+  EvolveProgress progress(isatty(STDERR_FILENO) == 1, config.episodes);
+
+  sim::evolve::DriverOptions options;
+  options.checkpoint_dir = args.checkpoint;
+  options.resume = args.resume;
+  options.curve_csv = args.log;
+  options.on_generation = [&](const sim::evolve::Coevolution& evo, const sim::evolve::GenerationStats& stats) {
+    progress.update(evo, stats);
+  };
+  const auto started = std::chrono::steady_clock::now();
+  sim::evolve::DriverResult result = [&] {
+    try {
+      return sim::evolve::drive(config, *evaluator, options);
+    } catch (const sim::evolve::CheckpointError& e) {
+      throw CommandError(3, e.what());
+    }
+  }();
+  progress.finish();
+  for (const auto& w : result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
+
+  const auto& evo = result.evolution;
+  const auto& best = evo.best();
+  // The best team once more, alone: its score and feasibility as the policy file
+  // reports them (the model is deterministic, so this confirms the recorded score).
+  const std::vector<sim::evolve::Team> final_team{best.team};
+  const sim::evolve::TeamResult final_result = evaluator->evaluate(final_team).front();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, best.team);
+  policy.provenance.method = sim::evolve::to_string(config.method);
+  policy.provenance.seed = config.seed;
+  policy.provenance.episodes = evo.episodes();
+  policy.provenance.score_m = final_result.score_m;
+  policy.provenance.robot_hash = robot.hash;
+  sim::save_policy(args.out, policy);
+
+  const std::int64_t episodes_here = evo.episodes() - result.resumed_episodes;
+  const double rate = wall_s > 0.0 ? static_cast<double>(episodes_here) / wall_s : 0.0;
+  const double infeasible_last = evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate();
+  if (args.json) {
+    const nlohmann::json j = {{"best_score_m", best.score_m},
+                              {"best_feasible", best.feasible},
+                              {"final_score_m", final_result.score_m},
+                              {"final_feasible", final_result.feasible},
+                              {"episodes", evo.episodes()},
+                              {"generations", evo.generation()},
+                              {"infeasible_rate_last", infeasible_last},
+                              {"resumed", result.resumed},
+                              {"threads", threads},
+                              {"wall_time_s", wall_s},
+                              {"episodes_per_s", rate},
+                              {"out", args.out},
+                              {"log", args.log}};
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("evolve %s: %d generations, %lld episodes%s\n", policy.provenance.method.c_str(), evo.generation(),
+                static_cast<long long>(evo.episodes()), result.resumed ? " (resumed)" : "");
+    std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
+                final_result.score_m, final_result.feasible ? "" : " INFEASIBLE");
+    std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
+    std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads\n", wall_s, rate, threads);
+    std::printf("  policy     %s\n  curve      %s\n", args.out.c_str(), args.log.c_str());
+  }
+}
+
+}  // namespace
+
+void add_evolve_command(CLI::App& app) {
+  auto args = std::make_shared<EvolveArgs>();
+  CLI::App* cmd = app.add_subcommand("evolve", "Coevolve a rolling policy (cooperative coevolution, paper Algorithm 1)");
+  cmd->add_option("--period", args->period_s, "Signal period, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
+  cmd->add_option("--complexity", args->complexity, "Values per cable signal")->capture_default_str()->check(CLI::Range(1, 16));
+  cmd->add_option("--method", args->method, "Fitness: historical|leniency|average")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"historical", "leniency", "average"}));
+  cmd->add_option("--episodes", args->episodes, "Episode budget")->capture_default_str()->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  cmd->add_option("--seed", args->seed, "Random seed (the run depends on it alone)")->capture_default_str();
+  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); results do not depend on it")
+      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--checkpoint", args->checkpoint, "Directory for a checkpoint after every generation");
+  cmd->add_flag("--resume", args->resume, "Continue the run checkpointed in --checkpoint");
+  cmd->add_option("--robot", args->robot, "Robot description")->check(CLI::ExistingFile);
+  cmd->add_option("--population", args->population, "Members per cable population")->capture_default_str()->check(CLI::Range(2, 100000));
+  cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
+  cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
+  cmd->add_option("--sigma", args->sigma_m, "Mutation step, metres (Gaussian, clamped to the limits)")->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
+  cmd->add_option("--out", args->out, "Policy file of the best team")->required();
+  cmd->add_option("--log", args->log, "Learning curve CSV")->required();
+  cmd->add_flag("--json", args->json, "Print a JSON summary");
+  cmd->callback([args] {
+    if (args->resume && args->checkpoint.empty()) throw CommandError(2, "--resume needs --checkpoint DIR");
+    run_evolve(*args);
+  });
+}
+
+}  // namespace tensegrity::cli

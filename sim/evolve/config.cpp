@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "sim/evolve/config.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "firmware/core/limits.hpp"
+
+namespace tensegrity::sim::evolve {
+
+const char* to_string(FitnessMethod method) {
+  switch (method) {
+    case FitnessMethod::historical: return "historical";
+    case FitnessMethod::leniency: return "leniency";
+    case FitnessMethod::average: return "average";
+  }
+  return "?";
+}
+
+FitnessMethod parse_fitness_method(const std::string& text) {
+  if (text == "historical") return FitnessMethod::historical;
+  if (text == "leniency") return FitnessMethod::leniency;
+  if (text == "average") return FitnessMethod::average;
+  throw ConfigError("unknown method '" + text + "' (historical, leniency or average)");
+}
+
+void validate(const EvolveConfig& c) {
+  auto fail = [](const std::string& what) { throw ConfigError("evolve config: " + what); };
+  if (c.population < 2) fail("population must be at least 2");
+  if (c.teams < 1) fail("teams must be at least 1");
+  // The copies come from the survivors: more than half would copy members that die.
+  if (c.replace < 1 || c.replace > c.population / 2) fail("replace must be in 1..population/2");
+  if (!(c.sigma_m >= 0.0) || !std::isfinite(c.sigma_m)) fail("sigma_m must be finite and >= 0");
+  if (c.episodes < 1) fail("episodes must be at least 1");
+  if (c.cables < 1) fail("cables must be at least 1");
+  if (c.complexity < 1 || c.complexity > static_cast<int>(core::kMaxComplexity)) {
+    fail("complexity must be in 1.." + std::to_string(core::kMaxComplexity));
+  }
+  if (!std::isfinite(c.min_rest_length_m) || !std::isfinite(c.max_rest_length_m) ||
+      !(c.min_rest_length_m < c.max_rest_length_m)) {
+    fail("rest-length limits must be finite with min < max");
+  }
+  if (!(c.period_s > 0.0) || !std::isfinite(c.period_s)) fail("period_s must be > 0");
+  if (!(c.duration_s > 0.0) || !std::isfinite(c.duration_s)) fail("duration_s must be > 0");
+}
+
+nlohmann::json config_to_json(const EvolveConfig& c) {
+  return nlohmann::json{{"method", to_string(c.method)},
+                        {"population", c.population},
+                        {"teams", c.teams},
+                        {"replace", c.replace},
+                        {"sigma_m", c.sigma_m},
+                        {"seed", c.seed},
+                        {"episodes", c.episodes},
+                        {"cables", c.cables},
+                        {"complexity", c.complexity},
+                        {"min_rest_length_m", c.min_rest_length_m},
+                        {"max_rest_length_m", c.max_rest_length_m},
+                        {"period_s", c.period_s},
+                        {"duration_s", c.duration_s},
+                        {"robot_name", c.robot_name},
+                        {"robot_hash", c.robot_hash}};
+}
+
+EvolveConfig config_from_json(const nlohmann::json& j) {
+  try {
+    EvolveConfig c;
+    c.method = parse_fitness_method(j.at("method").get<std::string>());
+    c.population = j.at("population").get<int>();
+    c.teams = j.at("teams").get<int>();
+    c.replace = j.at("replace").get<int>();
+    c.sigma_m = j.at("sigma_m").get<double>();
+    c.seed = j.at("seed").get<std::uint64_t>();
+    c.episodes = j.at("episodes").get<std::int64_t>();
+    c.cables = j.at("cables").get<int>();
+    c.complexity = j.at("complexity").get<int>();
+    c.min_rest_length_m = j.at("min_rest_length_m").get<double>();
+    c.max_rest_length_m = j.at("max_rest_length_m").get<double>();
+    c.period_s = j.at("period_s").get<double>();
+    c.duration_s = j.at("duration_s").get<double>();
+    c.robot_name = j.at("robot_name").get<std::string>();
+    c.robot_hash = j.at("robot_hash").get<std::string>();
+    return c;
+  } catch (const nlohmann::json::exception& e) {
+    throw ConfigError(std::string("evolve config: ") + e.what());
+  }
+}
+
+std::vector<std::string> config_differences(const EvolveConfig& a, const EvolveConfig& b) {
+  const nlohmann::json ja = config_to_json(a);
+  const nlohmann::json jb = config_to_json(b);
+  std::vector<std::string> out;
+  for (const auto& [key, value] : ja.items()) {
+    if (value != jb.at(key)) out.push_back(key + ": " + value.dump() + " -> " + jb.at(key).dump());
+  }
+  return out;
+}
+
+}  // namespace tensegrity::sim::evolve

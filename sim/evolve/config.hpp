@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Everything that decides a coevolution run's result, so that a checkpoint can be
+// checked against the run it is asked to continue. The thread count is not here on
+// purpose: results do not depend on it.
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace tensegrity::sim::evolve {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Credit assignment: how a member's team scores become its fitness (paper, sec. 4).
+enum class FitnessMethod {
+  historical,  // mean of every score since the member was created (kept across generations)
+  leniency,    // best score of this generation
+  average,     // mean score of this generation (history cleared every generation)
+};
+
+const char* to_string(FitnessMethod method);
+// Throws ConfigError naming the accepted values.
+FitnessMethod parse_fitness_method(const std::string& text);
+
+struct EvolveConfig {
+  FitnessMethod method = FitnessMethod::historical;
+  int population = 10;  // members per cable population
+  int teams = 50;       // random teams evaluated per generation
+  int replace = 5;      // worst members replaced by mutated copies of the best
+  // Mutation: every value of a copy gets a N(0, sigma^2) step, clamped to the limits.
+  double sigma_m = 0.05;
+  std::uint64_t seed = 0;
+  std::int64_t episodes = 5000;  // budget; the last generation may have fewer teams
+  int cables = 24;
+  int complexity = 5;
+  double min_rest_length_m = 0.6;
+  double max_rest_length_m = 1.1;
+  // What the teams are evaluated on; the algorithm itself does not read these.
+  double period_s = 4.0;
+  double duration_s = 60.0;
+  std::string robot_name;
+  std::string robot_hash;
+};
+
+// Throws ConfigError on the first nonsensical value (e.g. replace > population / 2).
+void validate(const EvolveConfig& config);
+
+nlohmann::json config_to_json(const EvolveConfig& config);
+EvolveConfig config_from_json(const nlohmann::json& j);
+// One line per field that differs, "field: a -> b"; empty when equal.
+std::vector<std::string> config_differences(const EvolveConfig& a, const EvolveConfig& b);
+
+}  // namespace tensegrity::sim::evolve

@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// Scores a team the way the paper does: the team becomes a policy, the policy is
+// played by the firmware's control core (CoreController) on the ODE model for one
+// episode from rest, and the score is the distance the centre moved; 0 when the
+// episode went infeasible.
+#include <memory>
+
+#include "sim/episode.hpp"
+#include "sim/evolve/config.hpp"
+#include "sim/evolve/evaluator.hpp"
+#include "sim/policy.hpp"
+#include "sim/robot.hpp"
+
+namespace tensegrity::sim::evolve {
+
+// The team as a policy file for `robot` (owners from the robot; provenance empty).
+Policy team_policy(const Robot& robot, double period_s, int complexity, const Team& team);
+
+// One episode of `duration_s` from the settled start. Thread-safe.
+TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, const Team& team);
+
+// The episode scorer on `threads` workers (each worker runs whole episodes).
+std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads);
+
+}  // namespace tensegrity::sim::evolve
