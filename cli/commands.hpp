@@ -22,5 +22,12 @@ void add_bench_command(CLI::App& app);
 void add_evolve_command(CLI::App& app);
 // `bench evolve`, added by add_bench_command.
 void add_bench_evolve_command(CLI::App& bench);
+// Ground tools over DDS (ground/): one file each.
+void add_upload_command(CLI::App& app);
+void add_start_command(CLI::App& app);
+void add_stop_command(CLI::App& app);
+void add_estop_command(CLI::App& app);
+void add_status_command(CLI::App& app);
+void add_record_command(CLI::App& app);
 
 }  // namespace tensegrity::cli

@@ -14,6 +14,12 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_sim_command(app);
   tensegrity::cli::add_bench_command(app);
   tensegrity::cli::add_evolve_command(app);
+  tensegrity::cli::add_upload_command(app);
+  tensegrity::cli::add_start_command(app);
+  tensegrity::cli::add_stop_command(app);
+  tensegrity::cli::add_estop_command(app);
+  tensegrity::cli::add_status_command(app);
+  tensegrity::cli::add_record_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity status`: a live table of the end caps (heartbeat age, active policy,
+// state, fault, tensions, clock offset); --once for one snapshot, --json for tools.
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "cli/ground_cli.hpp"
+#include "ground/status.hpp"
+
+namespace tensegrity::cli {
+
+void add_status_command(CLI::App& app) {
+  struct Args {
+    bool once = false;
+    bool json = false;
+    double period_s = 0.5;
+    GroundOptions ground;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand("status", "Show the end caps' state, live");
+  cmd->add_flag("--once", args->once, "Print one snapshot (after --timeout seconds of listening) and exit");
+  cmd->add_flag("--json", args->json, "JSON instead of a table");
+  cmd->add_option("--period", args->period_s, "Refresh period in seconds")->check(CLI::Range(0.05, 60.0));
+  add_ground_options(*cmd, args->ground, 3.0);
+  cmd->callback([args] {
+    // Live status is a host: its heartbeat keeps the end caps' host watchdog fed.
+    auto station = make_station(args->ground, /*publish_heartbeat=*/!args->once);
+    auto print = [&] {
+      const auto snap = station->snapshot();
+      const std::int64_t now = ground::Station::now_ns();
+      const std::string text = args->json ? ground::format_status_json(snap, now) + "\n"
+                                          : ground::format_status_table(snap, now);
+      std::fputs(text.c_str(), stdout);
+      std::fflush(stdout);
+    };
+    if (args->once) {
+      wait_for_endcaps(*station, args->ground, false);
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));  // telemetry too
+      print();
+      return;
+    }
+    for (;;) {
+      if (!args->json) std::fputs("\033[H\033[2J", stdout);  // clear screen: a live table
+      print();
+      std::this_thread::sleep_for(std::chrono::duration<double>(args->period_s));
+    }
+  });
+}
+
+}  // namespace tensegrity::cli

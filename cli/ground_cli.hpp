@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: Apache-2.0
+// Options every ground subcommand shares (DDS domain, end-cap set, timeout), and
+// the translation of a ground report into the exit code.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "ground/station.hpp"
+
+namespace tensegrity::cli {
+
+struct GroundOptions {
+  int domain = -1;  // -1: TENSEGRITY_DOMAIN or the default
+  double timeout_s = 5.0;
+  std::string endcaps = "0-11";
+};
+
+void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_timeout_s);
+// "0-11", "3", "0,2,5-7" -> mask; throws CommandError(2) naming the bad part.
+std::uint16_t parse_endcap_set(const std::string& text);
+std::unique_ptr<ground::Station> make_station(const GroundOptions& options, bool publish_heartbeat = true);
+// Waits (up to the timeout) for the addressed end caps' heartbeats so that a
+// command is not sent into discovery; returns false when some are missing.
+bool wait_for_endcaps(ground::Station& station, const GroundOptions& options, bool synced);
+
+}  // namespace tensegrity::cli

@@ -1,0 +1,304 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ground/station.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+#include "msgs/dds.hpp"
+#include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
+#include "tensegrity_msgs/msg/CommandPubSubTypes.h"
+#include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
+#include "tensegrity_msgs/msg/PolicyAckPubSubTypes.h"
+#include "tensegrity_msgs/msg/PolicyTablePubSubTypes.h"
+#include "tensegrity_msgs/msg/TelemetryPubSubTypes.h"
+#include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"
+
+namespace tensegrity::ground {
+
+namespace dds = eprosima::fastdds::dds;
+
+namespace {
+bool valid_endcap(int id) { return id >= 0 && id < kEndcapCount; }
+}  // namespace
+
+// One listener per reader; each takes its samples in the receive thread.
+struct StationListeners {
+  class Listener final : public dds::DataReaderListener {
+   public:
+    Listener(Station& station, void (*fn)(Station&, dds::DataReader*), const char* topic)
+        : station_(station), fn_(fn), topic_(topic) {}
+    void on_data_available(dds::DataReader* reader) override { fn_(station_, reader); }
+    void on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus&) override {
+      std::fprintf(stderr, "ground: incompatible QoS offered on %s\n", topic_);
+    }
+
+   private:
+    Station& station_;
+    void (*fn_)(Station&, dds::DataReader*);
+    const char* topic_;
+  };
+
+  static void policy_acks(Station& s, dds::DataReader* r);
+  static void command_acks(Station& s, dds::DataReader* r);
+  static void telemetry(Station& s, dds::DataReader* r);
+  static void heartbeats(Station& s, dds::DataReader* r);
+  static void time_sync(Station& s, dds::DataReader* r);
+};
+
+struct Station::Dds {
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  dds::DataWriter* policy = nullptr;
+  dds::DataWriter* command = nullptr;
+  dds::DataWriter* heartbeat = nullptr;
+  dds::DataWriter* sync_reply = nullptr;
+  std::vector<std::unique_ptr<StationListeners::Listener>> listeners;
+  std::mutex write_mutex;  // the time-sync reply writer is used from the receive thread
+
+  ~Dds() { msgs::delete_participant(participant); }
+  dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
+    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
+    dds::DataWriter* w = publisher->create_datawriter_with_profile(topic, spec.profile);
+    if (w == nullptr) throw msgs::DdsError(std::string("cannot create writer on ") + spec.name);
+    return w;
+  }
+  void reader(Station& station, const msgs::TopicSpec& spec, dds::TypeSupport type,
+              void (*fn)(Station&, dds::DataReader*)) {
+    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
+    listeners.push_back(std::make_unique<StationListeners::Listener>(station, fn, spec.name));
+    if (subscriber->create_datareader_with_profile(topic, spec.profile, listeners.back().get()) == nullptr) {
+      throw msgs::DdsError(std::string("cannot create reader on ") + spec.name);
+    }
+  }
+};
+
+std::int64_t Station::now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+Station::Station(const StationOptions& options) : options_(options), dds_(std::make_unique<Dds>()) {
+  Dds& d = *dds_;
+  d.participant = msgs::create_participant(options.domain, options.name);
+  d.publisher = d.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  d.subscriber = d.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (d.publisher == nullptr || d.subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
+  d.policy = d.writer(msgs::kPolicyTableTopic, dds::TypeSupport(new msg::PolicyTable_PubSubType()));
+  d.command = d.writer(msgs::kCommandTopic, dds::TypeSupport(new msg::Command_PubSubType()));
+  d.heartbeat = d.writer(msgs::kHostHeartbeatTopic, dds::TypeSupport(new msg::Heartbeat_PubSubType()));
+  d.sync_reply = d.writer(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new msg::TimeSyncReply_PubSubType()));
+  d.reader(*this, msgs::kPolicyAckTopic, dds::TypeSupport(new msg::PolicyAck_PubSubType()),
+           &StationListeners::policy_acks);
+  d.reader(*this, msgs::kCommandAckTopic, dds::TypeSupport(new msg::CommandAck_PubSubType()),
+           &StationListeners::command_acks);
+  d.reader(*this, msgs::kTelemetryTopic, dds::TypeSupport(new msg::Telemetry_PubSubType()),
+           &StationListeners::telemetry);
+  d.reader(*this, msgs::kEndcapHeartbeatTopic, dds::TypeSupport(new msg::Heartbeat_PubSubType()),
+           &StationListeners::heartbeats);
+  if (options.serve_time) {
+    d.reader(*this, msgs::kTimeSyncRequestTopic, dds::TypeSupport(new msg::TimeSyncRequest_PubSubType()),
+             &StationListeners::time_sync);
+  }
+  if (options.publish_heartbeat) heartbeat_thread_ = std::make_unique<std::thread>([this] { heartbeat_loop(); });
+}
+
+Station::~Station() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  stop_cv_.notify_all();
+  if (heartbeat_thread_) heartbeat_thread_->join();
+  dds_.reset();
+}
+
+void Station::heartbeat_loop() {
+  const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / options_.heartbeat_rate_hz));
+  std::uint32_t seq = 0;
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    lock.unlock();
+    msg::Heartbeat_ hb;
+    hb.format_version(msgs::kFormatVersion);
+    hb.source(-1);
+    hb.seq(++seq);
+    hb.time_ns(now_ns());
+    dds_->heartbeat->write(&hb);
+    lock.lock();
+    stop_cv_.wait_for(lock, period, [this] { return stopping_; });
+  }
+}
+
+void Station::write_policy(const msg::PolicyTable_& table) {
+  msg::PolicyTable_ copy = table;
+  dds_->policy->write(&copy);
+}
+
+void Station::write_command(const msg::Command_& command) {
+  msg::Command_ copy = command;
+  dds_->command->write(&copy);
+}
+
+std::vector<msg::PolicyAck_> Station::take_policy_acks() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(policy_acks_, {});
+}
+
+std::vector<msg::CommandAck_> Station::take_command_acks() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(command_acks_, {});
+}
+
+void Station::wait_for_acks(std::int64_t deadline_ns) {
+  std::unique_lock lock(mutex_);
+  const std::int64_t wait = deadline_ns - now_ns();
+  if (wait <= 0) return;
+  changed_.wait_for(lock, std::chrono::nanoseconds(wait),
+                    [this] { return !policy_acks_.empty() || !command_acks_.empty(); });
+}
+
+std::array<EndcapStatus, kEndcapCount> Station::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return status_;
+}
+
+bool Station::wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const {
+  std::unique_lock lock(mutex_);
+  auto ready = [&] {
+    for (int i = 0; i < kEndcapCount; ++i) {
+      if ((mask & (1U << i)) == 0) continue;
+      if (!status_[i].seen || (synced && !status_[i].heartbeat.clock_synced())) return false;
+    }
+    return true;
+  };
+  while (!ready()) {
+    const std::int64_t wait = deadline_ns - now_ns();
+    if (wait <= 0) return false;
+    changed_.wait_for(lock, std::chrono::nanoseconds(std::min<std::int64_t>(wait, 50'000'000)));
+  }
+  return true;
+}
+
+void Station::on_telemetry(std::function<void(const msg::Telemetry_&, std::int64_t)> callback) {
+  std::lock_guard lock(mutex_);
+  telemetry_callback_ = std::move(callback);
+}
+
+std::uint64_t Station::time_sync_replies() const {
+  std::lock_guard lock(mutex_);
+  return sync_replies_;
+}
+
+void StationListeners::policy_acks(Station& s, dds::DataReader* r) {
+  msg::PolicyAck_ ack;
+  dds::SampleInfo info;
+  while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    std::lock_guard lock(s.mutex_);
+    if (ack.format_version() != msgs::kFormatVersion) {
+      std::fprintf(stderr, "ground: REFUSED policy ack from end cap %d: format version %u, we speak %u\n",
+                   int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
+      continue;
+    }
+    s.policy_acks_.push_back(ack);
+    s.changed_.notify_all();
+  }
+}
+
+void StationListeners::command_acks(Station& s, dds::DataReader* r) {
+  msg::CommandAck_ ack;
+  dds::SampleInfo info;
+  while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    std::lock_guard lock(s.mutex_);
+    if (ack.format_version() != msgs::kFormatVersion) {
+      std::fprintf(stderr, "ground: REFUSED command ack from end cap %d: format version %u, we speak %u\n",
+                   int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
+      continue;
+    }
+    s.command_acks_.push_back(ack);
+    s.changed_.notify_all();
+  }
+}
+
+void StationListeners::telemetry(Station& s, dds::DataReader* r) {
+  msg::Telemetry_ t;
+  dds::SampleInfo info;
+  while (r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
+    const std::int64_t now = Station::now_ns();
+    if (!info.valid_data || !valid_endcap(t.endcap_id())) continue;
+    std::function<void(const msg::Telemetry_&, std::int64_t)> callback;
+    {
+      std::lock_guard lock(s.mutex_);
+      EndcapStatus& e = s.status_[static_cast<std::size_t>(t.endcap_id())];
+      if (t.format_version() != msgs::kFormatVersion) {
+        if (e.refused++ % 1000 == 0) {
+          std::fprintf(stderr, "ground: REFUSED telemetry from end cap %d: format version %u, we speak %u\n",
+                       int{t.endcap_id()}, unsigned{t.format_version()}, unsigned{msgs::kFormatVersion});
+        }
+        continue;
+      }
+      if (e.have_telemetry && t.seq() > e.telemetry.seq() + 1) e.telemetry_gaps += t.seq() - e.telemetry.seq() - 1;
+      e.have_telemetry = true;
+      e.telemetry = t;
+      e.telemetry_host_ns = now;
+      ++e.telemetry_count;
+      callback = s.telemetry_callback_;
+    }
+    if (callback) callback(t, now);
+  }
+}
+
+void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
+  msg::Heartbeat_ hb;
+  dds::SampleInfo info;
+  while (r->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data || !valid_endcap(hb.source())) continue;
+    std::lock_guard lock(s.mutex_);
+    EndcapStatus& e = s.status_[static_cast<std::size_t>(hb.source())];
+    if (hb.format_version() != msgs::kFormatVersion) {
+      if (e.refused++ % 100 == 0) {
+        std::fprintf(stderr, "ground: REFUSED heartbeat from end cap %d: format version %u, we speak %u\n",
+                     int{hb.source()}, unsigned{hb.format_version()}, unsigned{msgs::kFormatVersion});
+      }
+      continue;
+    }
+    e.seen = true;
+    e.heartbeat = hb;
+    e.heartbeat_host_ns = Station::now_ns();
+    s.changed_.notify_all();
+  }
+}
+
+void StationListeners::time_sync(Station& s, dds::DataReader* r) {
+  msg::TimeSyncRequest_ req;
+  dds::SampleInfo info;
+  while (r->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
+    const std::int64_t t2 = Station::now_ns();
+    if (!info.valid_data || req.format_version() != msgs::kFormatVersion) continue;
+    msg::TimeSyncReply_ reply;
+    reply.format_version(msgs::kFormatVersion);
+    reply.endcap_id(req.endcap_id());
+    reply.seq(req.seq());
+    reply.t1_ns(req.t1_ns());
+    reply.t2_ns(t2);
+    std::lock_guard write_lock(s.dds_->write_mutex);
+    reply.t3_ns(Station::now_ns());
+    s.dds_->sync_reply->write(&reply);
+    std::lock_guard lock(s.mutex_);
+    ++s.sync_replies_;
+  }
+}
+
+}  // namespace tensegrity::ground

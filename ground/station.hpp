@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: Apache-2.0
+// The host's end of the DDS link, used by every ground tool and by the HIL
+// launcher: one participant with the host's writers (policy tables, commands,
+// host heartbeat, time-sync replies) and readers (acks, telemetry, end-cap
+// heartbeats, time-sync requests). It answers time-sync requests from the DDS
+// receive thread itself, so the host side of the exchange adds no queueing.
+//
+// Host time is this machine's CLOCK_MONOTONIC: every ground tool on the host
+// shares it, so an end cap's offset stays valid from one tool to the next.
+#pragma once
+
+#include <array>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tensegrity_msgs/msg/Command.h"
+#include "tensegrity_msgs/msg/CommandAck.h"
+#include "tensegrity_msgs/msg/Heartbeat.h"
+#include "tensegrity_msgs/msg/PolicyAck.h"
+#include "tensegrity_msgs/msg/PolicyTable.h"
+#include "tensegrity_msgs/msg/Telemetry.h"
+
+namespace tensegrity::ground {
+
+namespace msg = tensegrity_msgs::msg::dds_;
+
+inline constexpr int kEndcapCount = 12;
+inline constexpr std::uint16_t kAllEndcaps = 0x0FFF;
+
+struct StationOptions {
+  int domain = 42;
+  std::string name = "ground";
+  // Observers (tests, a second monitor) can stay silent so that they do not keep
+  // the end caps' host-loss watchdog satisfied.
+  bool publish_heartbeat = true;
+  double heartbeat_rate_hz = 5.0;
+  bool serve_time = true;
+};
+
+struct EndcapStatus {
+  bool seen = false;               // a heartbeat arrived
+  std::int64_t heartbeat_host_ns = 0;  // host clock at its arrival
+  msg::Heartbeat_ heartbeat;
+  bool have_telemetry = false;
+  std::int64_t telemetry_host_ns = 0;
+  msg::Telemetry_ telemetry;
+  std::uint64_t telemetry_count = 0;
+  std::uint64_t telemetry_gaps = 0;  // samples missing by sequence number
+  std::uint64_t refused = 0;         // samples with another message-format version
+};
+
+class Station {
+ public:
+  explicit Station(const StationOptions& options);
+  ~Station();
+  Station(const Station&) = delete;
+  Station& operator=(const Station&) = delete;
+
+  static std::int64_t now_ns();
+
+  void write_policy(const msg::PolicyTable_& table);
+  void write_command(const msg::Command_& command);
+
+  // Acks received since the last call (any thread may wait, one should take).
+  std::vector<msg::PolicyAck_> take_policy_acks();
+  std::vector<msg::CommandAck_> take_command_acks();
+  // Returns when an ack arrives or at `deadline_ns` (host clock).
+  void wait_for_acks(std::int64_t deadline_ns);
+
+  std::array<EndcapStatus, kEndcapCount> snapshot() const;
+  // True once every end cap in `mask` sent a heartbeat (and, with `synced`, says
+  // its clock is synchronized); false at the deadline.
+  bool wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const;
+  // Called from the DDS receive thread for every valid telemetry sample, with the
+  // host clock at arrival. Set before samples are expected; keep it short.
+  void on_telemetry(std::function<void(const msg::Telemetry_&, std::int64_t)> callback);
+
+  // Time-sync requests answered so far (for tests and the status line).
+  std::uint64_t time_sync_replies() const;
+
+ private:
+  struct Dds;
+  friend struct StationListeners;
+  void heartbeat_loop();
+
+  StationOptions options_;
+  std::unique_ptr<Dds> dds_;
+  mutable std::mutex mutex_;
+  mutable std::condition_variable changed_;
+  std::array<EndcapStatus, kEndcapCount> status_{};
+  std::vector<msg::PolicyAck_> policy_acks_;
+  std::vector<msg::CommandAck_> command_acks_;
+  std::function<void(const msg::Telemetry_&, std::int64_t)> telemetry_callback_;
+  std::uint64_t sync_replies_ = 0;
+  bool stopping_ = false;
+  std::condition_variable stop_cv_;
+  std::unique_ptr<std::thread> heartbeat_thread_;
+};
+
+}  // namespace tensegrity::ground

@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ground/status.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+
+#include "firmware/core/fault.hpp"
+
+namespace tensegrity::ground {
+
+const char* mode_name(std::uint8_t mode) {
+  switch (mode) {
+    case 0: return "idle";
+    case 1: return "running";
+    case 2: return "faulted";
+    default: return "?";
+  }
+}
+
+const char* fault_name(std::uint8_t fault) {
+  switch (static_cast<core::FaultCause>(fault)) {
+    case core::FaultCause::none: return "-";
+    case core::FaultCause::over_tension: return "over_tension";
+    case core::FaultCause::drive_fault: return "drive_fault";
+    case core::FaultCause::drive_lost: return "drive_lost";
+    case core::FaultCause::sensor_timeout: return "sensor_timeout";
+    case core::FaultCause::host_lost: return "host_lost";
+    case core::FaultCause::emergency_stop: return "emergency_stop";
+    case core::FaultCause::bad_input: return "bad_input";
+  }
+  return "?";
+}
+
+std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns) {
+  std::string out =
+      "endcap  hb_age_s  policy                    state    fault           tension_n        offset_ms  rtt_ms  "
+      "host\n";
+  char line[512];
+  for (int e = 0; e < kEndcapCount; ++e) {
+    const EndcapStatus& s = status[static_cast<std::size_t>(e)];
+    if (!s.seen) {
+      std::snprintf(line, sizeof line, "%6d  %8s  (no heartbeat)\n", e, "-");
+      out += line;
+      continue;
+    }
+    const auto& hb = s.heartbeat;
+    const std::string policy = hb.active_policy_id().size() == 0
+                                   ? "-"
+                                   : hb.active_policy_id().to_string() + " v" +
+                                         std::to_string(hb.active_policy_version());
+    char tensions[64] = "-";
+    if (s.have_telemetry) {
+      const auto& t = s.telemetry.tension_n();
+      std::snprintf(tensions, sizeof tensions, "%.0f/%.0f", t[0], t[1]);
+    }
+    std::snprintf(line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s\n", e,
+                  static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9, policy.c_str(), mode_name(hb.mode()),
+                  fault_name(hb.fault()), tensions,
+                  hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
+                  hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0,
+                  hb.host_lost() ? "LOST" : "ok");
+    out += line;
+  }
+  return out;
+}
+
+std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns) {
+  nlohmann::json endcaps = nlohmann::json::array();
+  for (int e = 0; e < kEndcapCount; ++e) {
+    const EndcapStatus& s = status[static_cast<std::size_t>(e)];
+    nlohmann::json j{{"endcap", e}, {"seen", s.seen}};
+    if (s.seen) {
+      const auto& hb = s.heartbeat;
+      j["heartbeat_age_s"] = static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9;
+      j["active_policy"] = hb.active_policy_id().to_string();
+      j["active_policy_version"] = hb.active_policy_version();
+      j["state"] = mode_name(hb.mode());
+      j["fault"] = fault_name(hb.fault());
+      j["clock_synced"] = hb.clock_synced();
+      j["clock_offset_s"] = static_cast<double>(hb.clock_offset_ns()) / 1e9;
+      j["clock_round_trip_s"] = static_cast<double>(hb.clock_round_trip_ns()) / 1e9;
+      j["host_lost"] = hb.host_lost();
+      j["loop_overruns"] = hb.loop_overruns();
+    }
+    if (s.have_telemetry) {
+      const auto& t = s.telemetry;
+      const std::size_t n = std::min<std::size_t>(t.motor_count(), 4);
+      j["tension_n"] = std::vector<double>(t.tension_n().begin(), t.tension_n().begin() + static_cast<long>(n));
+      j["commanded_rest_length_m"] = std::vector<double>(t.commanded_rest_length_m().begin(),
+                                                         t.commanded_rest_length_m().begin() + static_cast<long>(n));
+      j["telemetry_samples"] = s.telemetry_count;
+      j["telemetry_gaps"] = s.telemetry_gaps;
+    }
+    endcaps.push_back(j);
+  }
+  return nlohmann::json{{"endcaps", endcaps}}.dump(2);
+}
+
+}  // namespace tensegrity::ground

@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: Apache-2.0
+// What every DDS participant of the project agrees on: the message-format version,
+// the domain id, the topic names with their QoS profile, and how a participant is
+// made (UDP only, profiles from msgs/qos_profiles.xml). See docs/dds.md.
+#pragma once
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace tensegrity::msgs {
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Every message's first field. A peer with another value is refused (and logged),
+// never decoded as if it were ours. Bump on any change to an IDL file.
+inline constexpr std::uint16_t kFormatVersion = 1;
+
+inline constexpr int kDefaultDomain = 42;
+// TENSEGRITY_DOMAIN if set (0..232, the range whose RTPS ports fit in 16 bits),
+// else kDefaultDomain. Throws DdsError naming the variable on a bad value.
+int domain_id();
+int parse_domain_id(std::string_view text);
+
+// QoS profile names in msgs/qos_profiles.xml.
+inline constexpr const char* kProfileDurable = "durable_events";
+inline constexpr const char* kProfileStream = "stream";
+inline constexpr const char* kProfileTimeSync = "time_sync";
+inline constexpr const char* kParticipantProfile = "tensegrity_participant";
+
+struct TopicSpec {
+  const char* name;     // ROS 2 style: "rt/" + ROS topic name
+  const char* type;     // registered type name (ROS 2: pkg::msg::dds_::Type_)
+  const char* profile;  // writer and reader profile of this topic
+};
+
+inline constexpr TopicSpec kPolicyTableTopic{"rt/tensegrity/policy_table", "tensegrity_msgs::msg::dds_::PolicyTable_", kProfileDurable};
+inline constexpr TopicSpec kPolicyAckTopic{"rt/tensegrity/policy_ack", "tensegrity_msgs::msg::dds_::PolicyAck_", kProfileDurable};
+inline constexpr TopicSpec kCommandTopic{"rt/tensegrity/command", "tensegrity_msgs::msg::dds_::Command_", kProfileDurable};
+inline constexpr TopicSpec kCommandAckTopic{"rt/tensegrity/command_ack", "tensegrity_msgs::msg::dds_::CommandAck_", kProfileDurable};
+inline constexpr TopicSpec kTelemetryTopic{"rt/tensegrity/telemetry", "tensegrity_msgs::msg::dds_::Telemetry_", kProfileStream};
+inline constexpr TopicSpec kHostHeartbeatTopic{"rt/tensegrity/host_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream};
+inline constexpr TopicSpec kEndcapHeartbeatTopic{"rt/tensegrity/endcap_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream};
+inline constexpr TopicSpec kTimeSyncRequestTopic{"rt/tensegrity/time_sync_request", "tensegrity_msgs::msg::dds_::TimeSyncRequest_", kProfileTimeSync};
+inline constexpr TopicSpec kTimeSyncReplyTopic{"rt/tensegrity/time_sync_reply", "tensegrity_msgs::msg::dds_::TimeSyncReply_", kProfileTimeSync};
+
+inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyAckTopic, kCommandTopic,
+                                                     kCommandAckTopic, kTelemetryTopic, kHostHeartbeatTopic,
+                                                     kEndcapHeartbeatTopic, kTimeSyncRequestTopic,
+                                                     kTimeSyncReplyTopic};
+
+// Loads the QoS profiles once per process: TENSEGRITY_QOS_FILE if set, else the
+// copy compiled in. Throws DdsError when Fast DDS rejects the XML.
+void load_qos_profiles();
+
+// A participant on `domain` with the UDP-only profile; throws DdsError on failure.
+// Delete with delete_participant (deletes its entities first).
+eprosima::fastdds::dds::DomainParticipant* create_participant(int domain, const std::string& name);
+void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
+
+// Registers `type` (once per participant) and creates the topic of `spec`.
+eprosima::fastdds::dds::Topic* create_topic(eprosima::fastdds::dds::DomainParticipant& participant,
+                                            const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type);
+
+}  // namespace tensegrity::msgs

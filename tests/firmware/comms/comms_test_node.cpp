@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: Apache-2.0
+// comms_test_node: N end caps' DDS nodes (firmware/comms) in one process, each with
+// a stub control loop (stub_loop.hpp), for the multi-process DDS tests. Runs until
+// SIGTERM/SIGINT. Prints "READY" once every node is up.
+//
+//   comms_test_node --domain D [--endcaps 0-11] [--loop-hz 500] [--telemetry-hz 100]
+//     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
+//     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "firmware/comms/endcap_node.hpp"
+#include "firmware/hal/storage.hpp"
+#include "tests/firmware/comms/stub_loop.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) { g_stop = 1; }
+
+// "0-11", "3", "0,2,5-7" -> bit mask
+unsigned parse_set(const std::string& text) {
+  unsigned mask = 0;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t comma = text.find(',', at);
+    const std::string part = text.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    const std::size_t dash = part.find('-');
+    const int lo = std::stoi(part.substr(0, dash));
+    const int hi = dash == std::string::npos ? lo : std::stoi(part.substr(dash + 1));
+    if (lo < 0 || hi > 15 || lo > hi) throw std::invalid_argument("bad end cap set '" + text + "'");
+    for (int i = lo; i <= hi; ++i) mask |= 1U << i;
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  return mask;
+}
+
+struct Endcap {
+  std::unique_ptr<tensegrity::test::OffsetClock> clock;
+  std::unique_ptr<tensegrity::fw::FileStorage> storage;
+  std::unique_ptr<tensegrity::fw::comms::EndcapNode> node;
+  std::unique_ptr<tensegrity::test::StubLoop> loop;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace tensegrity;
+  int domain = -1;
+  unsigned endcaps = 0x0FFF;
+  unsigned stop_set = 0;
+  double loop_hz = 500.0;
+  double spread_s = 0.0;
+  std::string storage_dir;
+  fw::comms::EndcapNodeConfig base;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
+        return argv[++i];
+      };
+      if (arg == "--domain") domain = std::stoi(value());
+      else if (arg == "--endcaps") endcaps = parse_set(value());
+      else if (arg == "--loop-hz") loop_hz = std::stod(value());
+      else if (arg == "--telemetry-hz") base.telemetry_rate_hz = std::stod(value());
+      else if (arg == "--host-loss") base.host_loss = fw::comms::parse_host_loss_action(value());
+      else if (arg == "--stop-on-host-loss") stop_set = parse_set(value());
+      else if (arg == "--host-timeout-s") base.host_timeout_s = std::stod(value());
+      else if (arg == "--clock-offset-spread-s") spread_s = std::stod(value());
+      else if (arg == "--storage") storage_dir = value();
+      else if (arg == "--motor-count") base.expect.motor_count = static_cast<std::uint32_t>(std::stoul(value()));
+      else if (arg == "--quiet") base.log = false;
+      else throw std::invalid_argument("unknown argument " + arg);
+    }
+    if (domain < 0) throw std::invalid_argument("--domain is required");
+    if (!(loop_hz > 0.0 && loop_hz <= 10000.0)) throw std::invalid_argument("--loop-hz must be in (0, 10000]");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "comms_test_node: %s\n", e.what());
+    return 2;
+  }
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGINT, on_signal);
+
+  std::mt19937_64 rng(1234);  // the same offsets every run
+  std::uniform_real_distribution<double> offset(-spread_s, spread_s);
+  std::vector<Endcap> caps;
+  try {
+    for (int e = 0; e < 16; ++e) {
+      if ((endcaps & (1U << e)) == 0) continue;
+      Endcap c;
+      c.clock = std::make_unique<test::OffsetClock>(static_cast<std::int64_t>(offset(rng) * 1e9));
+      if (!storage_dir.empty()) {
+        const auto dir = std::filesystem::path(storage_dir) / ("endcap" + std::to_string(e));
+        std::filesystem::create_directories(dir);
+        c.storage = std::make_unique<fw::FileStorage>(dir);
+      }
+      fw::comms::EndcapNodeConfig config = base;
+      config.endcap_id = e;
+      config.domain = domain;
+      if ((stop_set & (1U << e)) != 0) config.host_loss = fw::comms::HostLossAction::stop;
+      c.node = std::make_unique<fw::comms::EndcapNode>(config, *c.clock, c.storage.get());
+      c.loop = std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count);
+      c.node->start();
+      c.loop->start();
+      caps.push_back(std::move(c));
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "comms_test_node: %s\n", e.what());
+    return 1;
+  }
+  std::printf("READY\n");
+  std::fflush(stdout);
+  while (g_stop == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (auto& c : caps) c.loop->stop();
+  for (auto& c : caps) c.node->stop();
+  return 0;
+}
