@@ -6,10 +6,17 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 mapfile -t wanted < <(sed -e 's/#.*//' -e 's/[[:space:]]//g' "$here/debian-packages.txt" | grep -v '^$')
 
+# Installed for this machine's architecture (or for all): with multiarch, other
+# architectures' copies of a package (libfastrtps-dev:armhf) do not count.
+native="$(dpkg --print-architecture)"
+installed() {
+  local status
+  status="$(dpkg-query -W -f='${Status} ${Architecture}\n' "$1" 2>/dev/null || true)"
+  grep -qE "^install ok installed ($native|all)$" <<<"$status"
+}
 missing=()
 for pkg in "${wanted[@]}"; do
-  status="$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)"
-  [[ "$status" == "install ok installed" ]] || missing+=("$pkg")
+  installed "$pkg" || missing+=("$pkg")
 done
 [[ ${#missing[@]} -eq 0 ]] && exit 0
 
@@ -19,6 +26,8 @@ if [[ $(id -u) -ne 0 ]]; then
 fi
 echo "setup: installing ${#missing[@]} Debian package(s): ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
+# A mirror caught mid-sync for one index (seen for a foreign architecture) is not
+# fatal: apt uses what it has; a real failure shows in the install below.
+apt-get update -qq || echo "setup: apt-get update reported errors; going on" >&2
 apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 echo "setup: done"
