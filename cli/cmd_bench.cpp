@@ -79,6 +79,7 @@ void add_bench_command(CLI::App& app) {
   sim_cmd->add_flag("--json", args->json, "Print one JSON object");
   sim_cmd->callback([args] { run_bench_sim(*args); });
   add_bench_evolve_command(*bench);
+  add_bench_hil_command(*bench);
 }
 
 }  // namespace tensegrity::cli

@@ -28,10 +28,18 @@
 #include "firmware/hal/clock.hpp"
 #include "firmware/hal/make_can_bus.hpp"
 #include "firmware/hal/storage.hpp"
+#ifdef TENSEGRITY_ENDCAP_DDS
+#include "firmware/comms/endcap_node.hpp"
+#include "msgs/dds.hpp"
+#endif
 
 namespace app = tensegrity::fw::app;
 namespace fw = tensegrity::fw;
 namespace core = tensegrity::core;
+#ifdef TENSEGRITY_ENDCAP_DDS
+namespace comms = tensegrity::fw::comms;
+namespace msgs = tensegrity::msgs;
+#endif
 
 namespace {
 
@@ -114,6 +122,8 @@ int main(int argc, char** argv) {
   std::string stats_path;
   bool start_on_boot = false;
   double duration_s = 0.0;
+  bool no_dds = false;
+  std::string host_loss = "continue";
   cli.add_option("--id", id, "end cap id, 0..11")->required();
   cli.add_option("--config", config_path, "configuration file (tensegrity-endcap/1 JSON)")->required();
   cli.add_option("--policy", policy_path,
@@ -121,6 +131,12 @@ int main(int argc, char** argv) {
   cli.add_flag("--start-on-boot", start_on_boot, "start playing the table as soon as the drives are enabled");
   cli.add_option("--stats-json", stats_path, "write loop timing and memory to this file at exit");
   cli.add_option("--duration-s", duration_s, "exit after this many seconds (0: run until SIGINT/SIGTERM)");
+  // Accepted in builds without DDS too (where they change nothing), so that
+  // launchers and tests pass the same arguments to every build.
+  cli.add_flag("--no-dds", no_dds, "run without the DDS link to the host (tables from --policy or storage)");
+  cli.add_option("--host-loss", host_loss, "when the host's heartbeat is lost: continue the gait, or stop")
+      ->check(CLI::IsMember({"continue", "stop"}))
+      ->capture_default_str();
   CLI11_PARSE(cli, argc, argv);
   g_id = id;
 
@@ -166,8 +182,32 @@ int main(int argc, char** argv) {
   }
 
   fw::SystemClock clock;
-  app::NullHostLink host;
-  auto loop = std::make_unique<app::ControlLoop>(*bus.bus, clock, host, app::make_loop_settings(config));
+  app::NullHostLink null_host;
+  app::HostLink* host = &null_host;
+#ifdef TENSEGRITY_ENDCAP_DDS
+  // The DDS node runs on its own threads and meets the loop only in mailboxes.
+  std::unique_ptr<comms::EndcapNode> node;
+  if (!no_dds) {
+    try {
+      comms::EndcapNodeConfig node_config;
+      node_config.endcap_id = id;
+      node_config.domain = msgs::domain_id();
+      node_config.expect.motor_count = config.motor_count;
+      node_config.expect.limits = config.limits;
+      node_config.host_loss = comms::parse_host_loss_action(host_loss);
+      node = std::make_unique<comms::EndcapNode>(node_config, clock, storage.get());
+      node->start();
+      host = node.get();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "endcap: DDS: %s\n", e.what());
+      return 2;
+    }
+  }
+#else
+  (void)no_dds;
+  (void)host_loss;
+#endif
+  auto loop = std::make_unique<app::ControlLoop>(*bus.bus, clock, *host, app::make_loop_settings(config));
   if (have_table && loop->load_table(table) != core::TableError::none) {
     log_text("stored table rejected by the core");  // cannot happen: validated above
   }
@@ -216,6 +256,9 @@ int main(int argc, char** argv) {
   }
   loop_stop.store(true);
   loop_thread.join();
+#ifdef TENSEGRITY_ENDCAP_DDS
+  if (node) node->stop();
+#endif
   app::AppEvent event;
   while (loop->pop_event(event)) log_event(event);
 

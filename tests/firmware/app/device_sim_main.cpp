@@ -9,10 +9,12 @@
 #include <vector>
 
 #include "firmware/hal/udp_can_bus.hpp"
-#include "tests/firmware/drivers/sim_devices.hpp"
+#include "hil/devices/cia402_drive.hpp"
+#include "hil/devices/load_cell.hpp"
 
 int main(int argc, char** argv) {
   using namespace tensegrity::fw;
+  namespace sim = tensegrity::hil;
   if (argc < 4) {
     std::fprintf(stderr, "usage: %s BIND_PORT ENDCAP_PORT SECONDS\n", argv[0]);
     return 2;

@@ -20,7 +20,8 @@
 #include "firmware/drivers/pdo_codec.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
-#include "tests/firmware/drivers/sim_devices.hpp"
+#include "hil/devices/cia402_drive.hpp"
+#include "hil/devices/load_cell.hpp"
 
 extern char** environ;
 
@@ -28,6 +29,7 @@ namespace tensegrity::fw {
 namespace {
 
 namespace fs = std::filesystem;
+namespace sim = tensegrity::hil;  // the emulated devices
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
@@ -39,7 +41,9 @@ std::uint16_t free_udp_port() {
 
 class ChildProcess {
  public:
-  explicit ChildProcess(const std::vector<std::string>& args) {
+  explicit ChildProcess(std::vector<std::string> args) {
+    // A cross build runs the end cap under qemu-user: no binfmt_misc here.
+    if (std::string(ENDCAP_EMULATOR).size() > 0) args.insert(args.begin(), ENDCAP_EMULATOR);
     std::vector<char*> argv;
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -108,7 +112,7 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
   };
   std::ofstream(dir / "endcap.json") << config.dump(2);
 
-  ChildProcess child({ENDCAP_BINARY, "--id", "2", "--config", (dir / "endcap.json").string(), "--policy",
+  ChildProcess child({ENDCAP_BINARY, "--no-dds", "--id", "2", "--config", (dir / "endcap.json").string(), "--policy",
                       (dir / "policy.json").string(), "--start-on-boot", "--stats-json",
                       (dir / "stats.json").string()});
   ASSERT_GT(child.pid(), 0);

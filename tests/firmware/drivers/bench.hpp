@@ -9,9 +9,16 @@
 #include "firmware/drivers/canopen_master.hpp"
 #include "firmware/hal/can_bus.hpp"
 #include "firmware/hal/clock.hpp"
-#include "sim_devices.hpp"
+#include "hil/devices/cia402_drive.hpp"
+#include "hil/devices/load_cell.hpp"
 
 namespace tensegrity::fw::sim {
+
+// The emulated devices live in hil/devices (shared with the HIL emulator).
+using hil::FrameOut;
+using hil::SimCia402Drive;
+using hil::SimLoadCell;
+using hil::SimNode;
 
 // Records what the master sends; the bench delivers it.
 class RecordingBus final : public CanBus {

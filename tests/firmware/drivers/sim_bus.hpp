@@ -13,9 +13,16 @@
 
 #include "firmware/hal/can_bus.hpp"
 #include "firmware/hal/clock.hpp"
-#include "tests/firmware/drivers/sim_devices.hpp"
+#include "hil/devices/cia402_drive.hpp"
+#include "hil/devices/load_cell.hpp"
 
 namespace tensegrity::fw::sim {
+
+// The emulated devices live in hil/devices (shared with the HIL emulator).
+using hil::FrameOut;
+using hil::SimCia402Drive;
+using hil::SimLoadCell;
+using hil::SimNode;
 
 class SimCanBus final : public CanBus {
  public:

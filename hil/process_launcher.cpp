@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "hil/process_launcher.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "hil/hil_error.hpp"
+
+namespace tensegrity::hil {
+
+namespace fs = std::filesystem;
+
+std::vector<std::uint16_t> free_udp_ports(int count) {
+  std::vector<int> fds;
+  std::vector<std::uint16_t> ports;
+  for (int i = 0; i < count; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof addr;
+    if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
+        ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len) != 0) {
+      if (fd >= 0) ::close(fd);
+      for (int f : fds) ::close(f);
+      throw HilError(std::string("cannot find a free UDP port: ") + std::strerror(errno));
+    }
+    fds.push_back(fd);  // held until all are chosen, so no two are the same
+    ports.push_back(ntohs(addr.sin_port));
+  }
+  for (int f : fds) ::close(f);
+  return ports;
+}
+
+fs::path default_endcap_binary() {
+  if (const char* env = std::getenv("TENSEGRITY_ENDCAP"); env != nullptr && *env != '\0') return env;
+#ifdef TENSEGRITY_ENDCAP_BINARY
+  return TENSEGRITY_ENDCAP_BINARY;
+#else
+  return "endcap";
+#endif
+}
+
+ProcessLauncher::ProcessLauncher(const LauncherConfig& config, const Provisioner& provisioner)
+    : config_(config), provisioner_(provisioner), slots_(config.endcap_count) {
+  if (!fs::exists(config_.endcap_binary)) {
+    throw HilError("end-cap program not found: " + config_.endcap_binary.string() +
+                   " (build the `endcap` target or set TENSEGRITY_ENDCAP)");
+  }
+  std::string templ = (fs::temp_directory_path() / "tensegrity-hil-XXXXXX").string();
+  if (::mkdtemp(templ.data()) == nullptr) throw HilError(std::string("mkdtemp: ") + std::strerror(errno));
+  dir_ = templ;
+  const std::vector<std::uint16_t> ports = free_udp_ports(config_.endcap_count);
+  for (int e = 0; e < config_.endcap_count; ++e) {
+    Slot& s = slots_[e];
+    s.port = ports[e];
+    const fs::path d = dir_ / ("endcap" + std::to_string(e));
+    fs::create_directories(d / "store");
+    s.config = d / "endcap.json";
+    s.log = d / "endcap.log";
+    s.stats = d / "stats.json";
+    const int motors = e < static_cast<int>(config_.motors_per_endcap.size()) ? config_.motors_per_endcap[e] : 2;
+    nlohmann::json drives = nlohmann::json::array();
+    for (int m = 0; m < motors; ++m) drives.push_back(kDriveNodeIds[m]);
+    const auto& l = config_.limits;
+    const nlohmann::json j = {
+        {"format", "tensegrity-endcap/1"},
+        {"bus", "udp:127.0.0.1:" + std::to_string(config_.hub_port) + ",bind=127.0.0.1:" + std::to_string(s.port)},
+        {"nodes", {{"drives", drives}, {"load_cell", kLoadCellNodeId}}},
+        {"spool", {{"radius_m", config_.spool.spool_radius_m}, {"counts_per_rev", config_.spool.counts_per_rev}}},
+        {"limits",
+         {{"min_rest_length_m", l.min_rest_length_m}, {"max_rest_length_m", l.max_rest_length_m},
+          {"speed_m_per_s", l.speed_m_per_s}, {"cutoff_tension_n", l.cutoff_tension_n},
+          {"hard_limit_tension_n", l.hard_limit_tension_n}}},
+        {"initial_rest_length_m", config_.spool.initial_rest_length_m},
+        {"storage_dir", (d / "store").string()},
+        {"loop", {{"rate_hz", 1000}, {"mode", to_string(config_.mode)}}},
+        {"timeouts", {{"drive_heartbeat_s", 0.1}, {"load_cell_heartbeat_s", 0.1}, {"load_cell_sample_s", 0.02}}},
+        {"start_on_boot", false},
+        {"stats_log_period_s", 10},
+    };
+    std::ofstream(s.config) << j.dump(2) << "\n";
+  }
+}
+
+ProcessLauncher::~ProcessLauncher() {
+  try {
+    shutdown();
+  } catch (...) {
+  }
+  if (!config_.keep_dir && !dir_.empty()) {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+}
+
+void ProcessLauncher::start_all() {
+  for (int e = 0; e < endcap_count(); ++e) {
+    bool skip = false;
+    for (int n : config_.never_start) skip = skip || n == e;
+    if (!skip) spawn(e, false);
+  }
+}
+
+void ProcessLauncher::spawn(int e, bool restart) {
+  Slot& s = slots_[e];
+  std::vector<std::string> args{config_.endcap_binary.string(), "--id", std::to_string(e), "--config", s.config.string(),
+                                "--stats-json", s.stats.string()};
+  for (auto& a : provisioner_.endcap_arguments(e, restart)) args.push_back(std::move(a));
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const int log_fd = ::open(s.log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (log_fd < 0) throw HilError(s.log.string() + ": " + std::strerror(errno));
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(log_fd);
+    throw HilError(std::string("fork: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    // Child: only async-signal-safe calls until exec.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(127);  // the launcher died before prctl
+    ::setpgid(0, 0);
+    ::dup2(log_fd, 1);
+    ::dup2(log_fd, 2);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  ::setpgid(pid, pid);  // also from here: no race with an early kill(-pid)
+  ::close(log_fd);
+  s.pid = pid;
+  s.exit_status = -1;
+  if (restart) ++s.restarts;
+}
+
+void ProcessLauncher::reap(int e, bool block) {
+  Slot& s = slots_[e];
+  if (s.pid <= 0) return;
+  int status = 0;
+  const pid_t r = ::waitpid(s.pid, &status, block ? 0 : WNOHANG);
+  if (r != s.pid) return;
+  s.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+  s.pid = -1;
+}
+
+std::string ProcessLauncher::log_text(int e) const {
+  std::ifstream in(slots_[e].log);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+double ProcessLauncher::cpu_s(int e) const {
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) return s.cpu_before_s;
+  std::ifstream in("/proc/" + std::to_string(s.pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');
+  if (close == std::string::npos) return s.cpu_before_s;
+  std::istringstream fields(text.substr(close + 2));
+  std::string f;
+  unsigned long long utime = 0, stime = 0;
+  // Fields after the command: state(3) ... utime(14) stime(15).
+  for (int i = 3; i <= 15 && (fields >> f); ++i) {
+    if (i == 14) utime = std::stoull(f);
+    if (i == 15) stime = std::stoull(f);
+  }
+  return s.cpu_before_s + static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
+bool ProcessLauncher::listening(int e) {
+  reap(e, false);
+  if (slots_[e].pid <= 0) return false;
+  char wanted[32];
+  std::snprintf(wanted, sizeof wanted, "0100007F:%04X", slots_[e].port);
+  std::ifstream in("/proc/net/udp");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find(wanted) != std::string::npos) return true;
+  }
+  return false;
+}
+
+std::string ProcessLauncher::describe(int e) {
+  reap(e, false);
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) {
+    std::string last;
+    std::istringstream log(log_text(e));
+    for (std::string line; std::getline(log, line);) {
+      if (!line.empty()) last = line;
+    }
+    if (s.exit_status == -1) return "not started";
+    return "process exited with status " + std::to_string(s.exit_status) + (last.empty() ? "" : "; last log line: " + last);
+  }
+  std::ifstream in("/proc/" + std::to_string(s.pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');
+  const char state = close != std::string::npos && close + 2 < text.size() ? text[close + 2] : '?';
+  std::string what = state == 'T' ? "stopped (SIGSTOP?)" : state == 'Z' ? "exited" : "running";
+  return "pid " + std::to_string(s.pid) + ", " + what;
+}
+
+void ProcessLauncher::kill(int e) {
+  Slot& s = slots_[e];
+  if (s.pid <= 0) return;
+  s.cpu_before_s = cpu_s(e);
+  ::kill(-s.pid, SIGKILL);
+  reap(e, true);
+}
+
+void ProcessLauncher::restart(int e) {
+  kill(e);
+  spawn(e, true);
+}
+
+std::vector<EndcapProcessReport> ProcessLauncher::shutdown() {
+  if (shut_down_) return reports_;
+  shut_down_ = true;
+  std::vector<double> cpu(slots_.size());
+  for (int e = 0; e < endcap_count(); ++e) {
+    cpu[e] = cpu_s(e);
+    if (slots_[e].pid > 0) {
+      ::kill(-slots_[e].pid, SIGCONT);  // a stopped one could not act on SIGTERM
+      ::kill(-slots_[e].pid, SIGTERM);
+    }
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+  for (;;) {
+    bool alive = false;
+    for (int e = 0; e < endcap_count(); ++e) {
+      reap(e, false);
+      alive = alive || slots_[e].pid > 0;
+    }
+    if (!alive) break;
+    if (std::chrono::steady_clock::now() > deadline) {
+      for (int e = 0; e < endcap_count(); ++e) {
+        if (slots_[e].pid > 0) ::kill(-slots_[e].pid, SIGKILL);
+        reap(e, true);
+      }
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  for (int e = 0; e < endcap_count(); ++e) {
+    EndcapProcessReport r;
+    r.endcap = e;
+    r.started = slots_[e].exit_status != -1;
+    r.exit_status = slots_[e].exit_status;
+    r.cpu_s = cpu[e];
+    r.restarts = slots_[e].restarts;
+    std::ifstream in(slots_[e].stats);
+    if (in) {
+      try {
+        r.stats = nlohmann::json::parse(in);
+      } catch (const std::exception&) {
+        r.stats = nullptr;
+      }
+    }
+    reports_.push_back(r);
+  }
+  return reports_;
+}
+
+}  // namespace tensegrity::hil

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: Apache-2.0
+// Starts and stops the twelve `endcap` programs of a HIL run: generated configs
+// in a temporary directory, a storage directory each, a free UDP port each on
+// 127.0.0.1, logs to files. No orphans: every child gets PR_SET_PDEATHSIG
+// (SIGKILL when the launcher dies, even by SIGKILL) and its own process group
+// (so a terminal's Ctrl-C reaches only the launcher, which then shuts the
+// children down in order, and a kill reaches anything a child started).
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "firmware/core/limits.hpp"
+#include "firmware/drivers/spool_geometry.hpp"
+#include "hil/provisioner.hpp"
+#include "hil/world_stepper.hpp"
+
+namespace tensegrity::hil {
+
+struct LauncherConfig {
+  std::filesystem::path endcap_binary;
+  int endcap_count = 12;
+  std::vector<int> motors_per_endcap;  // from the robot; default 2 each
+  std::uint16_t hub_port = 0;
+  StepperMode mode = StepperMode::lockstep;
+  fw::SpoolGeometry spool;
+  core::MotorLimits limits;
+  bool keep_dir = false;          // leave configs, stores and logs behind (debugging)
+  std::vector<int> never_start;   // tests: end caps whose program is not started
+};
+
+struct EndcapProcessReport {
+  int endcap = 0;
+  bool started = false;
+  int exit_status = -1;    // exit code, or -signal
+  double cpu_s = 0.0;      // user + system, read from /proc/PID/stat before the stop
+  std::uint64_t restarts = 0;
+  nlohmann::json stats;    // the program's --stats-json (its last run), null if absent
+};
+
+class ProcessLauncher final : public EndcapProcesses {
+ public:
+  ProcessLauncher(const LauncherConfig& config, const Provisioner& provisioner);
+  ~ProcessLauncher() override;
+  ProcessLauncher(const ProcessLauncher&) = delete;
+  ProcessLauncher& operator=(const ProcessLauncher&) = delete;
+
+  void start_all();
+  std::uint16_t endcap_port(int endcap) const { return slots_[endcap].port; }
+  int endcap_count() const { return static_cast<int>(slots_.size()); }
+  bool started(int endcap) const { return slots_[endcap].pid > 0; }
+  pid_t pid(int endcap) const { return slots_[endcap].pid; }
+  std::string log_text(int endcap) const;
+  const std::filesystem::path& dir() const { return dir_; }
+  // CPU seconds so far of a running end cap, from /proc/PID/stat.
+  double cpu_s(int endcap) const;
+
+  bool listening(int endcap) override;
+  std::string describe(int endcap) override;
+  void kill(int endcap) override;
+  void restart(int endcap) override;
+
+  // SIGTERM, wait (then SIGKILL), collect stats; idempotent.
+  std::vector<EndcapProcessReport> shutdown();
+
+ private:
+  struct Slot {
+    std::uint16_t port = 0;
+    pid_t pid = -1;
+    int exit_status = -1;
+    double cpu_before_s = 0.0;  // CPU of earlier (killed) incarnations
+    std::uint64_t restarts = 0;
+    std::filesystem::path config, log, stats;
+  };
+  void spawn(int endcap, bool restart);
+  void reap(int endcap, bool block);
+
+  LauncherConfig config_;
+  const Provisioner& provisioner_;
+  std::filesystem::path dir_;
+  std::vector<Slot> slots_;
+  std::vector<EndcapProcessReport> reports_;
+  bool shut_down_ = false;
+};
+
+// Free UDP ports on 127.0.0.1 (bound to port 0 together, then released).
+std::vector<std::uint16_t> free_udp_ports(int count);
+// The `endcap` program: $TENSEGRITY_ENDCAP, else the one built with this tree.
+std::filesystem::path default_endcap_binary();
+
+}  // namespace tensegrity::hil

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "hil/recorder.hpp"
+
+#include "hil/hil_error.hpp"
+
+namespace tensegrity::hil {
+
+Recorder::Recorder(const std::filesystem::path& path, const sim::Model& model) : path_(path) {
+  file_ = std::fopen(path.c_str(), "w");
+  if (file_ == nullptr) throw HilError(path.string() + ": cannot create the record file");
+  std::fputs("time_s,centre_x_m,centre_y_m,centre_z_m", file_);
+  for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",rest_length_m_%d", c);
+  for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",tension_n_%d", c);
+  std::fputc('\n', file_);
+}
+
+Recorder::~Recorder() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+void Recorder::record(double time_s, const sim::Model& model) {
+  const auto centre = model.centre_m();
+  std::fprintf(file_, "%.3f,%.6f,%.6f,%.6f", time_s, centre.x(), centre.y(), centre.z());
+  for (double r : model.rest_length_m()) std::fprintf(file_, ",%.6f", r);
+  for (double t : model.tension_n()) std::fprintf(file_, ",%.3f", t);
+  std::fputc('\n', file_);
+}
+
+void Recorder::close() {
+  if (file_ == nullptr) return;
+  const bool bad = std::ferror(file_) != 0;
+  const bool close_failed = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (bad || close_failed) throw HilError(path_.string() + ": write error");
+}
+
+}  // namespace tensegrity::hil

@@ -1,0 +1,192 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "hil/scenario.hpp"
+
+#include <algorithm>
+#include <array>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "hil/hil_error.hpp"
+
+namespace tensegrity::hil {
+
+namespace {
+
+constexpr std::array<std::pair<FaultKind, const char*>, 10> kNames{{
+    {FaultKind::drive_fault, "drive_fault"},
+    {FaultKind::drive_silent, "drive_silent"},
+    {FaultKind::load_cell_stuck, "load_cell_stuck"},
+    {FaultKind::load_cell_drift, "load_cell_drift"},
+    {FaultKind::drop_frames, "drop_frames"},
+    {FaultKind::corrupt_frames, "corrupt_frames"},
+    {FaultKind::kill_endcap, "kill_endcap"},
+    {FaultKind::restart_endcap, "restart_endcap"},
+    {FaultKind::cut_dds, "cut_dds"},
+    {FaultKind::restore_dds, "restore_dds"},
+}};
+
+FaultKind fault_from_name(const std::string& name, const std::string& where) {
+  for (const auto& [kind, text] : kNames) {
+    if (name == text) return kind;
+  }
+  std::string known;
+  for (const auto& [kind, text] : kNames) known += std::string(known.empty() ? "" : ", ") + text;
+  throw HilError(where + ": unknown fault '" + name + "' (known: " + known + ")");
+}
+
+void check_endcap(int endcap, int endcap_count, const std::string& where) {
+  if (endcap < 0 || endcap >= endcap_count) {
+    throw HilError(where + ": endcap " + std::to_string(endcap) + " out of range 0.." + std::to_string(endcap_count - 1));
+  }
+}
+
+FaultParams parse_params(const nlohmann::json& p, const std::string& where) {
+  FaultParams out;
+  if (p.is_null()) return out;
+  if (!p.is_object()) throw HilError(where + ".params: must be an object");
+  for (const auto& [key, value] : p.items()) {
+    const std::string at = where + ".params." + key;
+    if (key == "motor") {
+      if (!value.is_number_integer() || value.get<int>() < -1 || value.get<int>() > 3) throw HilError(at + ": an integer -1..3");
+      out.motor = value.get<int>();
+    } else if (key == "code") {
+      if (!value.is_number_unsigned() || value.get<unsigned>() > 0xFFFF) throw HilError(at + ": an integer 0..65535");
+      out.code = static_cast<std::uint16_t>(value.get<unsigned>());
+    } else if (key == "release") {
+      if (!value.is_boolean()) throw HilError(at + ": true or false");
+      out.release = value.get<bool>();
+    } else if (key == "n_per_s") {
+      if (!value.is_number()) throw HilError(at + ": a number");
+      out.n_per_s = value.get<double>();
+    } else if (key == "probability") {
+      if (!value.is_number() || value.get<double>() < 0.0 || value.get<double>() > 1.0) throw HilError(at + ": a number 0..1");
+      out.probability = value.get<double>();
+    } else if (key == "duration_s") {
+      if (!value.is_number() || value.get<double>() < 0.0) throw HilError(at + ": a number >= 0");
+      out.duration_s = value.get<double>();
+    } else if (key == "kind") {
+      if (value == "frame") {
+        out.corrupt_kind = CorruptKind::frame;
+      } else if (value == "datagram") {
+        out.corrupt_kind = CorruptKind::datagram;
+      } else {
+        throw HilError(at + ": \"frame\" or \"datagram\"");
+      }
+    } else {
+      throw HilError(at + ": unknown parameter");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* to_string(FaultKind kind) {
+  for (const auto& [k, text] : kNames) {
+    if (k == kind) return text;
+  }
+  return "unknown";
+}
+
+std::string ScenarioEvent::describe() const {
+  std::ostringstream s;
+  s << "t=" << time_s << " s end cap " << endcap << ": " << to_string(fault);
+  switch (fault) {
+    case FaultKind::drive_fault:
+      s << " (motor " << params.motor << ", EMCY 0x" << std::hex << params.code << std::dec
+        << (params.release ? ", released" : ", holding") << ")";
+      break;
+    case FaultKind::drive_silent: s << " (motor " << params.motor << ")"; break;
+    case FaultKind::load_cell_drift: s << " (" << params.n_per_s << " N/s)"; break;
+    case FaultKind::drop_frames:
+    case FaultKind::corrupt_frames:
+      s << " (p " << params.probability << ", " << (params.duration_s > 0 ? std::to_string(params.duration_s) + " s" : "to the end")
+        << ")";
+      break;
+    default: break;
+  }
+  return s.str();
+}
+
+void sort_events(Scenario& scenario) {
+  std::stable_sort(scenario.events.begin(), scenario.events.end(),
+                   [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.time_s < b.time_s; });
+}
+
+Scenario parse_scenario(const std::string& text, int endcap_count, const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw HilError(source + ": not JSON: " + e.what());
+  }
+  const nlohmann::json* list = &j;
+  if (j.is_object()) {
+    if (j.contains("format") && j["format"] != "tensegrity-hil-scenario/1") {
+      throw HilError(source + ": format: expected \"tensegrity-hil-scenario/1\"");
+    }
+    if (!j.contains("events")) throw HilError(source + ": events: missing");
+    list = &j["events"];
+  }
+  if (!list->is_array()) throw HilError(source + ": events: must be a list");
+  Scenario scenario;
+  for (std::size_t i = 0; i < list->size(); ++i) {
+    const auto& e = (*list)[i];
+    const std::string where = source + ": events[" + std::to_string(i) + "]";
+    if (!e.is_object()) throw HilError(where + ": must be an object");
+    for (const auto& [key, value] : e.items()) {
+      if (key != "time_s" && key != "endcap" && key != "fault" && key != "params") {
+        throw HilError(where + "." + key + ": unknown field");
+      }
+    }
+    ScenarioEvent ev;
+    if (!e.contains("time_s") || !e["time_s"].is_number() || e["time_s"].get<double>() < 0.0) {
+      throw HilError(where + ".time_s: a number >= 0 is required");
+    }
+    ev.time_s = e["time_s"].get<double>();
+    if (!e.contains("fault") || !e["fault"].is_string()) throw HilError(where + ".fault: a string is required");
+    ev.fault = fault_from_name(e["fault"].get<std::string>(), where + ".fault");
+    const bool needs_endcap = ev.fault != FaultKind::cut_dds && ev.fault != FaultKind::restore_dds;
+    if (e.contains("endcap")) {
+      if (!e["endcap"].is_number_integer()) throw HilError(where + ".endcap: an integer");
+      ev.endcap = e["endcap"].get<int>();
+      check_endcap(ev.endcap, endcap_count, where + ".endcap");
+    } else if (needs_endcap) {
+      throw HilError(where + ".endcap: required for " + to_string(ev.fault));
+    }
+    ev.params = parse_params(e.contains("params") ? e["params"] : nlohmann::json(), where);
+    scenario.events.push_back(ev);
+  }
+  sort_events(scenario);
+  return scenario;
+}
+
+Scenario load_scenario(const std::filesystem::path& path, int endcap_count) {
+  std::ifstream in(path);
+  if (!in) throw HilError(path.string() + ": cannot read");
+  std::stringstream s;
+  s << in.rdbuf();
+  return parse_scenario(s.str(), endcap_count, path.string());
+}
+
+ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
+  const auto colon = text.find(':');
+  const auto at = text.find('@');
+  if (colon == std::string::npos || at == std::string::npos || at < colon) {
+    throw HilError("--fault '" + text + "': expected ENDCAP:FAULT@TIME_S, e.g. 3:drive_fault@2.0");
+  }
+  ScenarioEvent ev;
+  try {
+    ev.endcap = std::stoi(text.substr(0, colon));
+    ev.time_s = std::stod(text.substr(at + 1));
+  } catch (const std::exception&) {
+    throw HilError("--fault '" + text + "': ENDCAP and TIME_S must be numbers");
+  }
+  check_endcap(ev.endcap, endcap_count, "--fault '" + text + "'");
+  ev.fault = fault_from_name(text.substr(colon + 1, at - colon - 1), "--fault '" + text + "'");
+  return ev;
+}
+
+}  // namespace tensegrity::hil

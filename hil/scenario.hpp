@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: Apache-2.0
+// Fault-injection scenarios: what goes wrong, where and when, as a JSON file
+//   {"format": "tensegrity-hil-scenario/1",
+//    "events": [{"time_s": 2.0, "endcap": 3, "fault": "drive_fault", "params": {"motor": 0}}, ...]}
+// or one `--fault` option per event ("3:drive_fault@2.0"). time_s is physics
+// time (table time 0 is the first physics step). Parsed and validated before
+// anything starts, so a typo costs nothing.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "hil/udp_hub.hpp"
+
+namespace tensegrity::hil {
+
+enum class FaultKind : std::uint8_t {
+  drive_fault,      // the drive faults (EMCY); params: motor, code, release
+  drive_silent,     // the drive stops answering (no heartbeat/PDO/SDO); params: motor (-1: all)
+  load_cell_stuck,  // value and sequence freeze
+  load_cell_drift,  // params: n_per_s
+  drop_frames,      // frames to the end cap lost; params: probability, duration_s
+  corrupt_frames,   // frames to the end cap corrupted; params: probability, duration_s, kind
+  kill_endcap,      // SIGKILL the end cap's process
+  restart_endcap,   // start it again (stored policy, start on boot); it rejoins in phase
+  cut_dds,          // needs the DDS link: reported as not done yet
+  restore_dds,
+};
+
+const char* to_string(FaultKind kind);
+
+struct FaultParams {
+  int motor = 0;              // -1: every motor of the end cap
+  std::uint16_t code = 0x2310;  // EMCY error code (0x2310: continuous over-current)
+  // A released drive lets its spool run free (brake off): the cable pays out to the
+  // spool's end stop, the maximum rest length, and goes slack. Default: the drive
+  // holds its cable (brake on), which is what a faulted CiA 402 drive does.
+  bool release = false;
+  double n_per_s = 5.0;       // load-cell drift
+  double probability = 0.1;   // drop/corrupt
+  double duration_s = 0.0;    // drop/corrupt: 0 = until the end
+  CorruptKind corrupt_kind = CorruptKind::frame;
+};
+
+struct ScenarioEvent {
+  double time_s = 0.0;
+  int endcap = 0;
+  FaultKind fault = FaultKind::drive_fault;
+  FaultParams params;
+  std::string describe() const;
+};
+
+struct Scenario {
+  std::vector<ScenarioEvent> events;  // sorted by time
+};
+
+// Errors (std::runtime_error, via HilError) name the source and the event index.
+Scenario parse_scenario(const std::string& json_text, int endcap_count, const std::string& source = "scenario");
+Scenario load_scenario(const std::filesystem::path& path, int endcap_count);
+// "ENDCAP:FAULT@TIME_S" (params default), e.g. "3:drive_fault@2.0".
+ScenarioEvent parse_fault_option(const std::string& text, int endcap_count);
+void sort_events(Scenario& scenario);
+
+}  // namespace tensegrity::hil

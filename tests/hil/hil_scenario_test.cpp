@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: Apache-2.0
+#include <gtest/gtest.h>
+
+#include "hil/hil_error.hpp"
+#include "hil/scenario.hpp"
+
+namespace tensegrity::hil {
+namespace {
+
+TEST(HilScenario, ParsesSortsAndDefaults) {
+  const Scenario s = parse_scenario(R"({"format": "tensegrity-hil-scenario/1", "events": [
+      {"time_s": 3.0, "endcap": 4, "fault": "kill_endcap"},
+      {"time_s": 1.5, "endcap": 3, "fault": "drive_fault", "params": {"motor": 1, "release": true}},
+      {"time_s": 2.0, "endcap": 5, "fault": "corrupt_frames", "params": {"probability": 0.2, "kind": "datagram"}},
+      {"time_s": 4.0, "fault": "cut_dds"}]})",
+                                    12);
+  ASSERT_EQ(s.events.size(), 4u);
+  EXPECT_EQ(s.events[0].fault, FaultKind::drive_fault);
+  EXPECT_EQ(s.events[0].params.motor, 1);
+  EXPECT_TRUE(s.events[0].params.release);
+  EXPECT_EQ(s.events[0].params.code, 0x2310);
+  EXPECT_EQ(s.events[1].params.corrupt_kind, CorruptKind::datagram);
+  EXPECT_EQ(s.events[2].fault, FaultKind::kill_endcap);
+  EXPECT_EQ(s.events[3].fault, FaultKind::cut_dds);
+}
+
+TEST(HilScenario, ErrorsNameTheField) {
+  const auto message = [](const std::string& text) {
+    try {
+      parse_scenario(text, 12, "s.json");
+    } catch (const HilError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(R"([{"time_s": 1, "endcap": 12, "fault": "kill_endcap"}])"),
+            "s.json: events[0].endcap: endcap 12 out of range 0..11");
+  EXPECT_NE(message(R"([{"time_s": 1, "endcap": 1, "fault": "explode"}])").find("unknown fault 'explode'"), std::string::npos);
+  EXPECT_EQ(message(R"([{"time_s": 1, "endcap": 1, "fault": "drop_frames", "params": {"probabilty": 1}}])"),
+            "s.json: events[0].params.probabilty: unknown parameter");
+}
+
+TEST(HilScenario, FaultOption) {
+  const ScenarioEvent e = parse_fault_option("3:drive_silent@2.5", 12);
+  EXPECT_EQ(e.endcap, 3);
+  EXPECT_EQ(e.fault, FaultKind::drive_silent);
+  EXPECT_DOUBLE_EQ(e.time_s, 2.5);
+  EXPECT_THROW(parse_fault_option("3-drive_silent", 12), HilError);
+}
+
+}  // namespace
+}  // namespace tensegrity::hil
