@@ -1,16 +1,43 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# The README's main job: build, then play the shipped rolling policy on the
-# SUPERball model and print the summary (extra arguments go to `tensegrity sim`).
+# The README's main job: build, take the shipped rolling policy (or evolve one with
+# --evolve), simulate it in-process, then roll it with 12 real end-cap firmware
+# processes against the ODE model (HIL, lockstep), and report: distance, per end
+# cap summary, and a plot (out/hil-run.png).
+#   scripts/run.sh [--evolve] [--duration S]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
+evolve=0
+duration=60
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --evolve) evolve=1 ;;
+    --duration) duration="$2"; shift ;;
+    -h|--help) sed -n '3,8p' "$0"; exit 0 ;;
+    *) echo "run: unknown argument $1 (try --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
 scripts/setup.sh
 cmake --preset release >/dev/null
-cmake --build --preset release -j "$(nproc)" --target tensegrity >/dev/null
-tensegrity=build/release/cli/tensegrity
+cmake --build --preset release -j "$(nproc)" --target tensegrity endcap >/dev/null
+bin=build/release
+tensegrity="$bin/cli/tensegrity"
+mkdir -p out
+
 policy=policies/superball-t4-n5.json
-if [[ -f "$policy" ]]; then
-  exec "$tensegrity" sim --policy "$policy" "$@"
+if [[ $evolve -eq 1 ]]; then
+  policy=out/evolved.json
+  echo "== evolving a policy (t = 4 s, n = 5, historical average, 5000 episodes)"
+  "$tensegrity" evolve --period 4 --complexity 5 --method historical --episodes 5000 --seed 1 \
+    --checkpoint out/evolve-checkpoint --resume --out "$policy" --log out/evolve-curve.csv
 fi
-echo "run: no shipped policy yet ($policy); playing the benchmark policy" >&2
-exec "$tensegrity" sim --benchmark-policy "$@"
+
+echo "== in-process simulation of $policy, ${duration} s"
+"$tensegrity" sim --policy "$policy" --duration "$duration"
+
+echo "== HIL: 12 endcap processes over CAN-over-UDP against the ODE model, lockstep, ${duration} s"
+"$tensegrity" hil --policy "$policy" --duration "$duration" --endcap "$bin/firmware/app/endcap" \
+  --record out/hil-run.csv
+python3 tools/plot_run.py out/hil-run.csv out/hil-run.png
