@@ -40,4 +40,5 @@ echo "== in-process simulation of $policy, ${duration} s"
 echo "== HIL: 12 endcap processes over CAN-over-UDP against the ODE model, lockstep, ${duration} s"
 "$tensegrity" hil --policy "$policy" --duration "$duration" --endcap "$bin/firmware/app/endcap" \
   --record out/hil-run.csv
-python3 tools/plot_run.py out/hil-run.csv out/hil-run.png
+# Debian's interpreter: it is the one python3-matplotlib installs into.
+/usr/bin/python3 tools/plot_run.py out/hil-run.csv out/hil-run.png
