@@ -27,6 +27,7 @@ void add_upload_command(CLI::App& app);
 void add_start_command(CLI::App& app);
 void add_stop_command(CLI::App& app);
 void add_estop_command(CLI::App& app);
+void add_clear_fault_command(CLI::App& app);
 void add_status_command(CLI::App& app);
 void add_record_command(CLI::App& app);
 // The HIL emulator (hil/): `hil`, and `bench hil` added by add_bench_command.

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_start_command(app);
   tensegrity::cli::add_stop_command(app);
   tensegrity::cli::add_estop_command(app);
+  tensegrity::cli::add_clear_fault_command(app);
   tensegrity::cli::add_status_command(app);
   tensegrity::cli::add_record_command(app);
   tensegrity::cli::add_hil_command(app);

@@ -6,22 +6,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 list="${1:-$here/debian-packages-cross.txt}"
-mapfile -t wanted < <(sed -e 's/#.*//' -e 's/[[:space:]]//g' "$list" | grep -v '^$')
-
-# A plain name means this machine's architecture (or all); name:arch that one.
-native="$(dpkg --print-architecture)"
-installed() {
-  local name="${1%%:*}" arch="$native"
-  [[ "$1" == *:* ]] && arch="${1##*:}"
-  local status
-  status="$(dpkg-query -W -f='${Status} ${Architecture}\n' "$name:$arch" 2>/dev/null || true
-            dpkg-query -W -f='${Status} ${Architecture}\n' "$name" 2>/dev/null || true)"
-  grep -qE "^install ok installed ($arch|all)$" <<<"$status"
-}
-missing=()
-for pkg in "${wanted[@]}"; do
-  installed "$pkg" || missing+=("$pkg")
-done
+mapfile -t missing < <("$here/missing-packages.sh" "$list")
 [[ ${#missing[@]} -eq 0 ]] && exit 0
 
 if [[ $(id -u) -ne 0 ]]; then

@@ -4,20 +4,7 @@
 # Idempotent and silent when everything is already there.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-mapfile -t wanted < <(sed -e 's/#.*//' -e 's/[[:space:]]//g' "$here/debian-packages.txt" | grep -v '^$')
-
-# Installed for this machine's architecture (or for all): with multiarch, other
-# architectures' copies of a package (libfastrtps-dev:armhf) do not count.
-native="$(dpkg --print-architecture)"
-installed() {
-  local status
-  status="$(dpkg-query -W -f='${Status} ${Architecture}\n' "$1" 2>/dev/null || true)"
-  grep -qE "^install ok installed ($native|all)$" <<<"$status"
-}
-missing=()
-for pkg in "${wanted[@]}"; do
-  installed "$pkg" || missing+=("$pkg")
-done
+mapfile -t missing < <("$here/missing-packages.sh" "$here/debian-packages.txt")
 [[ ${#missing[@]} -eq 0 ]] && exit 0
 
 if [[ $(id -u) -ne 0 ]]; then

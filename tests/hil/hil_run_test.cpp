@@ -113,7 +113,11 @@ TEST(HilRun, BarrierTimeoutNamesAStoppedEndCap) {
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.error.find("end cap 9 sent no RPDO1 for drive node(s) 1, 3"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find("stopped"), std::string::npos) << r.error;
-  EXPECT_NE(r.error.find("physics step 500"), std::string::npos) << r.error;
+  // SIGSTOP races the SYNC the stepper sends right after step 500: the end cap may
+  // or may not have answered it before it stopped.
+  EXPECT_TRUE(r.error.find("physics step 500") != std::string::npos ||
+              r.error.find("physics step 501") != std::string::npos)
+      << r.error;
 }
 
 TEST(HilRun, DriveFaultPutsTheEndCapInSafeStateAndIsReported) {
