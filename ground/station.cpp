@@ -67,18 +67,12 @@ struct Station::Dds {
 
   ~Dds() { msgs::delete_participant(participant); }
   dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
-    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
-    dds::DataWriter* w = publisher->create_datawriter_with_profile(topic, spec.profile);
-    if (w == nullptr) throw msgs::DdsError(std::string("cannot create writer on ") + spec.name);
-    return w;
+    return msgs::create_writer(*participant, *publisher, spec, type);
   }
   void reader(Station& station, const msgs::TopicSpec& spec, dds::TypeSupport type,
               void (*fn)(Station&, dds::DataReader*)) {
-    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
     listeners.push_back(std::make_unique<StationListeners::Listener>(station, fn, spec.name));
-    if (subscriber->create_datareader_with_profile(topic, spec.profile, listeners.back().get()) == nullptr) {
-      throw msgs::DdsError(std::string("cannot create reader on ") + spec.name);
-    }
+    msgs::create_reader(*participant, *subscriber, spec, type, listeners.back().get());
   }
 };
 

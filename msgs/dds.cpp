@@ -82,4 +82,20 @@ dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& s
   return topic;
 }
 
+dds::DataWriter* create_writer(dds::DomainParticipant& participant, dds::Publisher& publisher,
+                               const TopicSpec& spec, dds::TypeSupport type) {
+  dds::Topic* topic = create_topic(participant, spec, type);
+  dds::DataWriter* writer = publisher.create_datawriter_with_profile(topic, spec.profile);
+  if (writer == nullptr) throw DdsError(std::string("cannot create writer on ") + spec.name);
+  return writer;
+}
+
+dds::DataReader* create_reader(dds::DomainParticipant& participant, dds::Subscriber& subscriber,
+                               const TopicSpec& spec, dds::TypeSupport type, dds::DataReaderListener* listener) {
+  dds::Topic* topic = create_topic(participant, spec, type);
+  dds::DataReader* reader = subscriber.create_datareader_with_profile(topic, spec.profile, listener);
+  if (reader == nullptr) throw DdsError(std::string("cannot create reader on ") + spec.name);
+  return reader;
+}
+
 }  // namespace tensegrity::msgs

@@ -5,6 +5,11 @@
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <array>
@@ -69,5 +74,16 @@ void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) 
 // Registers `type` (once per participant) and creates the topic of `spec`.
 eprosima::fastdds::dds::Topic* create_topic(eprosima::fastdds::dds::DomainParticipant& participant,
                                             const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type);
+
+// The writer / reader of `spec`'s topic with its QoS profile; both ends of the link
+// (the end cap's node and the ground station) create theirs through these.
+// Throw DdsError naming the topic.
+eprosima::fastdds::dds::DataWriter* create_writer(eprosima::fastdds::dds::DomainParticipant& participant,
+                                                  eprosima::fastdds::dds::Publisher& publisher,
+                                                  const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type);
+eprosima::fastdds::dds::DataReader* create_reader(eprosima::fastdds::dds::DomainParticipant& participant,
+                                                  eprosima::fastdds::dds::Subscriber& subscriber,
+                                                  const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type,
+                                                  eprosima::fastdds::dds::DataReaderListener* listener);
 
 }  // namespace tensegrity::msgs

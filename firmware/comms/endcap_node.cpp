@@ -114,16 +114,10 @@ struct EndcapNode::Dds {
   ~Dds() { msgs::delete_participant(participant); }
 
   dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
-    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
-    dds::DataWriter* w = publisher->create_datawriter_with_profile(topic, spec.profile);
-    if (w == nullptr) throw msgs::DdsError(std::string("cannot create writer on ") + spec.name);
-    return w;
+    return msgs::create_writer(*participant, *publisher, spec, type);
   }
   dds::DataReader* reader(const msgs::TopicSpec& spec, dds::TypeSupport type, CallbackListener* listener) {
-    dds::Topic* topic = msgs::create_topic(*participant, spec, type);
-    dds::DataReader* r = subscriber->create_datareader_with_profile(topic, spec.profile, listener);
-    if (r == nullptr) throw msgs::DdsError(std::string("cannot create reader on ") + spec.name);
-    return r;
+    return msgs::create_reader(*participant, *subscriber, spec, type, listener);
   }
 };
 

@@ -39,4 +39,8 @@ WaitResult wait_readable(int fd, std::int64_t deadline_ns) {
   }
 }
 
+bool send_error_is_transient(int error_number) {
+  return error_number == EAGAIN || error_number == EWOULDBLOCK || error_number == ENOBUFS;
+}
+
 }  // namespace tensegrity::fw::detail

@@ -14,4 +14,9 @@ std::int64_t receive_deadline_ns(std::int64_t timeout_ns);
 // Waits until `fd` is readable or CLOCK_MONOTONIC passes `deadline_ns`.
 WaitResult wait_readable(int fd, std::int64_t deadline_ns);
 
+// What a failed send's errno means to the caller: a full transmit queue (EAGAIN,
+// EWOULDBLOCK, or ENOBUFS as a full CAN queue shows itself) is `would_block`,
+// anything else `io_error`.
+bool send_error_is_transient(int error_number);
+
 }  // namespace tensegrity::fw::detail

@@ -102,10 +102,7 @@ CanResult SocketCanBus::send(const CanFrame& frame) {
     if (n < 0 && errno == EINTR) continue;
     ++counters_.tx_dropped;
     last_errno_ = n < 0 ? errno : EIO;
-    // ENOBUFS is how a full CAN transmit queue shows itself.
-    return (last_errno_ == EAGAIN || last_errno_ == EWOULDBLOCK || last_errno_ == ENOBUFS)
-               ? CanResult::would_block
-               : CanResult::io_error;
+    return detail::send_error_is_transient(last_errno_) ? CanResult::would_block : CanResult::io_error;
   }
 }
 

@@ -104,9 +104,7 @@ CanResult UdpCanBus::send(const CanFrame& frame) {
     if (n < 0 && errno == EINTR) continue;
     ++counters_.tx_dropped;
     last_errno_ = n < 0 ? errno : EMSGSIZE;
-    return (last_errno_ == EAGAIN || last_errno_ == EWOULDBLOCK || last_errno_ == ENOBUFS)
-               ? CanResult::would_block
-               : CanResult::io_error;
+    return detail::send_error_is_transient(last_errno_) ? CanResult::would_block : CanResult::io_error;
   }
 }
 
