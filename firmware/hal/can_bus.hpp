@@ -37,6 +37,10 @@ class CanBus {
   // timeout_ns == 0: poll once; < 0: wait without limit. Data frames only; error
   // reports are absorbed into counters().
   virtual CanResult receive(CanFrame& frame, std::int64_t timeout_ns) = 0;
+  // Sends what send() has queued. Most backends send at once and have nothing to
+  // do; the UDP backend in batch mode gathers a cycle's frames into one datagram.
+  // The control loop calls it once at the end of every cycle.
+  virtual CanResult flush() { return CanResult::ok; }
   virtual CanCounters counters() const = 0;
 };
 

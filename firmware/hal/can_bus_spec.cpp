@@ -9,6 +9,7 @@ namespace {
 constexpr std::string_view kUdpPrefix = "udp:";
 constexpr std::string_view kSocketCanPrefix = "socketcan:";
 constexpr std::string_view kBindKey = "bind=";
+constexpr std::string_view kBatchKey = "batch";
 constexpr std::size_t kIfNameMax = 15;  // IFNAMSIZ - 1 on Linux
 
 std::string quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
@@ -55,7 +56,7 @@ bool parse_can_bus_spec(std::string_view spec, CanBusSpec& out, std::string& err
     return true;
   }
   if (spec.starts_with(kUdpPrefix)) {
-    std::string_view rest = spec.substr(kUdpPrefix.size());
+    const std::string_view rest = spec.substr(kUdpPrefix.size());
     const std::size_t comma = rest.find(',');
     const std::string_view remote = rest.substr(0, comma);
     if (!parse_udp_endpoint(remote, result.remote, error)) {
@@ -66,23 +67,37 @@ bool parse_can_bus_spec(std::string_view spec, CanBusSpec& out, std::string& err
       error = "udp: remote port must not be 0";
       return false;
     }
-    if (comma != std::string_view::npos) {
-      const std::string_view option = rest.substr(comma + 1);
-      if (!option.starts_with(kBindKey)) {
-        error = "udp: unknown option " + quoted(option) + " (only bind=HOST:PORT)";
+    // Options after the remote, comma-separated, each at most once.
+    bool seen_bind = false;
+    for (std::size_t at = comma; at != std::string_view::npos;) {
+      const std::size_t next = rest.find(',', at + 1);
+      const std::string_view option =
+          rest.substr(at + 1, next == std::string_view::npos ? std::string_view::npos : next - at - 1);
+      const bool bind = option.starts_with(kBindKey);
+      if ((bind && seen_bind) || (option == kBatchKey && result.batch)) {
+        error = "udp: option " + quoted(option) + " given twice";
         return false;
       }
-      if (!parse_udp_endpoint(option.substr(kBindKey.size()), result.bind, error)) {
-        error = "udp: bind: " + error;
+      if (bind) {
+        if (!parse_udp_endpoint(option.substr(kBindKey.size()), result.bind, error)) {
+          error = "udp: bind: " + error;
+          return false;
+        }
+        seen_bind = true;
+      } else if (option == kBatchKey) {
+        result.batch = true;
+      } else {
+        error = "udp: unknown option " + quoted(option) + " (bind=HOST:PORT, batch)";
         return false;
       }
+      at = next;
     }
     result.kind = CanBusSpec::Kind::udp;
     out = std::move(result);
     return true;
   }
   error = "unknown CAN bus " + quoted(spec) +
-          "; expected udp:HOST:PORT[,bind=HOST:PORT] or socketcan:IFNAME";
+          "; expected udp:HOST:PORT[,bind=HOST:PORT][,batch] or socketcan:IFNAME";
   return false;
 }
 

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Text form of a CAN bus choice, as given on a command line or in a config file:
-//   udp:HOST:PORT[,bind=HOST:PORT]   frames over UDP to HOST:PORT (docs/udp-can.md);
-//                                    bind defaults to 0.0.0.0:0 (any port)
+//   udp:HOST:PORT[,bind=HOST:PORT][,batch]
+//                                    frames over UDP to HOST:PORT (docs/udp-can.md);
+//                                    bind defaults to 0.0.0.0:0 (any port); batch:
+//                                    send a cycle's frames as one version-2 datagram
 //   socketcan:IFNAME                 a Linux CAN interface, e.g. can0 or vcan0
 #pragma once
 
@@ -21,6 +23,7 @@ struct CanBusSpec {
   Kind kind = Kind::udp;
   UdpEndpoint remote;         // udp
   UdpEndpoint bind;           // udp
+  bool batch = false;         // udp: send version 2 (the peer must read it)
   std::string interface_name; // socketcan
 };
 

@@ -18,7 +18,7 @@ MakeCanBusResult make_can_bus(const std::string& spec) {
   if (parsed.kind == CanBusSpec::Kind::socketcan) {
     result.bus = SocketCanBus::open(parsed.interface_name, error);
   } else {
-    result.bus = UdpCanBus::open(UdpCanConfig{parsed.remote, parsed.bind}, error);
+    result.bus = UdpCanBus::open(UdpCanConfig{parsed.remote, parsed.bind, parsed.batch}, error);
   }
   if (!result.bus) result.error = "CAN bus '" + spec + "': " + error;
   return result;

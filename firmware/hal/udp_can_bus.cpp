@@ -55,12 +55,13 @@ std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::stri
   }
   socklen_t len = sizeof(local);
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &len);
-  std::unique_ptr<UdpCanBus> bus(new UdpCanBus(fd, ntohs(local.sin_port)));
+  std::unique_ptr<UdpCanBus> bus(new UdpCanBus(fd, ntohs(local.sin_port), config.batch));
   if (config.remote.port != 0 && !bus->set_remote(config.remote, error)) return nullptr;
   return bus;
 }
 
-UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port) : fd_(fd), local_port_(local_port) {}
+UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port, bool batch)
+    : fd_(fd), local_port_(local_port), batch_(batch) {}
 
 UdpCanBus::~UdpCanBus() { ::close(fd_); }
 
@@ -89,56 +90,61 @@ CanResult UdpCanBus::send(const CanFrame& frame) {
     last_errno_ = EDESTADDRREQ;
     return CanResult::io_error;
   }
+  if (!batch_) {
+    const udp_can::Datagram d = udp_can::encode(frame);
+    return send_bytes(d, 1);
+  }
+  // Full: the queued frames go now, so a long burst (bring-up) is never refused.
+  if (tx_batch_.full()) (void)flush();
+  tx_batch_.add(frame);
+  return CanResult::ok;
+}
+
+CanResult UdpCanBus::flush() {
+  if (tx_batch_.empty()) return CanResult::ok;
+  const CanResult r = send_bytes(tx_batch_.bytes(), tx_batch_.count());
+  tx_batch_.clear();
+  return r;
+}
+
+CanResult UdpCanBus::send_bytes(std::span<const std::uint8_t> bytes, std::size_t frames) {
   sockaddr_in to{};
   to.sin_family = AF_INET;
   to.sin_addr.s_addr = remote_addr_be_;
   to.sin_port = remote_port_be_;
-  const udp_can::Datagram d = udp_can::encode(frame);
   for (;;) {
-    const ssize_t n = ::sendto(fd_, d.data(), d.size(), MSG_DONTWAIT,
+    const ssize_t n = ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT,
                                reinterpret_cast<const sockaddr*>(&to), sizeof(to));
-    if (n == static_cast<ssize_t>(d.size())) {
-      ++counters_.tx_frames;
+    if (n == static_cast<ssize_t>(bytes.size())) {
+      counters_.tx_frames += frames;
       return CanResult::ok;
     }
     if (n < 0 && errno == EINTR) continue;
-    ++counters_.tx_dropped;
+    counters_.tx_dropped += frames;
     last_errno_ = n < 0 ? errno : EMSGSIZE;
     return detail::send_error_is_transient(last_errno_) ? CanResult::would_block : CanResult::io_error;
   }
 }
 
-CanResult UdpCanBus::receive(CanFrame& frame, std::int64_t timeout_ns) {
-  const std::int64_t deadline_ns = detail::receive_deadline_ns(timeout_ns);
-  // One byte more than a valid datagram so that an oversized one is seen as such.
-  std::array<std::uint8_t, udp_can::kDatagramBytes + 1> buffer{};
-  for (;;) {
-    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      if (errno != EAGAIN && errno != EWOULDBLOCK) {
-        last_errno_ = errno;
-        return CanResult::io_error;
-      }
-      if (timeout_ns == 0) return CanResult::timeout;
-      switch (detail::wait_readable(fd_, deadline_ns)) {
-        case detail::WaitResult::ready: continue;
-        case detail::WaitResult::timeout: return CanResult::timeout;
-        case detail::WaitResult::error: last_errno_ = errno; return CanResult::io_error;
-      }
-      continue;
-    }
-    // MSG_TRUNC makes n the datagram's real length even when it did not fit.
-    const std::size_t size = static_cast<std::size_t>(n);
-    const std::span<const std::uint8_t> bytes(buffer.data(), size < buffer.size() ? size : buffer.size());
+// Frames go to the queue receive() hands out; error reports to the counters;
+// whatever fails the checks is counted by reason.
+void UdpCanBus::take_datagram(std::span<const std::uint8_t> datagram) {
+  const udp_can::DatagramReader reader(datagram);
+  if (reader.status() != udp_can::Decoded::frame) {
+    ++counters_.rx_malformed;
+    ++drops_[static_cast<std::size_t>(reader.status())];
+    return;
+  }
+  rx_next_ = 0;
+  rx_count_ = 0;
+  for (std::size_t i = 0; i < reader.count(); ++i) {
     CanFrame got;
-    const udp_can::Decoded decoded =
-        size > udp_can::kDatagramBytes ? udp_can::Decoded::bad_size : udp_can::decode(bytes, got);
+    const udp_can::Decoded decoded = reader.read(i, got);
     switch (decoded) {
       case udp_can::Decoded::frame:
         ++counters_.rx_frames;
-        frame = got;
-        return CanResult::ok;
+        rx_queue_[rx_count_++] = got;
+        break;
       case udp_can::Decoded::error_report:
         can_error::apply_error_report(counters_, got.id);
         break;
@@ -147,7 +153,47 @@ CanResult UdpCanBus::receive(CanFrame& frame, std::int64_t timeout_ns) {
         ++drops_[static_cast<std::size_t>(decoded)];
         break;
     }
-    // Dropped or absorbed: keep looking until the deadline.
+  }
+}
+
+CanResult UdpCanBus::receive(CanFrame& frame, std::int64_t timeout_ns) {
+  const std::int64_t deadline_ns = detail::receive_deadline_ns(timeout_ns);
+  // One byte more than the largest valid datagram so that an oversized one is seen as such.
+  std::array<std::uint8_t, udp_can::kMaxDatagramBytes + 1> buffer;
+  for (;;) {
+    if (rx_next_ < rx_count_) {
+      frame = rx_queue_[rx_next_++];
+      return CanResult::ok;
+    }
+    // A caller prepared to wait has usually drained the socket already (a lockstep
+    // end cap between two SYNCs): wait first, then read, saving a recv() that
+    // would only say EAGAIN.
+    if (timeout_ns != 0) {
+      switch (detail::wait_readable(fd_, deadline_ns)) {
+        case detail::WaitResult::ready: break;
+        case detail::WaitResult::timeout: return CanResult::timeout;
+        case detail::WaitResult::error: last_errno_ = errno; return CanResult::io_error;
+      }
+    }
+    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (errno != EAGAIN && errno != EWOULDBLOCK) {
+        last_errno_ = errno;
+        return CanResult::io_error;
+      }
+      if (timeout_ns == 0) return CanResult::timeout;
+      continue;  // woken without a datagram: wait again
+    }
+    // MSG_TRUNC makes n the datagram's real length even when it did not fit.
+    const auto size = static_cast<std::size_t>(n);
+    if (size > udp_can::kMaxDatagramBytes) {
+      ++counters_.rx_malformed;
+      ++drops_[static_cast<std::size_t>(udp_can::Decoded::bad_size)];
+      continue;
+    }
+    take_datagram({buffer.data(), size});
+    // Dropped or absorbed frames: keep looking until the deadline.
   }
 }
 

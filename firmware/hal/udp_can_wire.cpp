@@ -57,15 +57,25 @@ Decoded decode(std::span<const std::uint8_t> datagram, CanFrame& frame) {
     if (datagram[i] != kMagic[i]) return Decoded::bad_magic;
   }
   if (datagram[4] != kVersion) return Decoded::bad_version;
-  const std::uint8_t flags = datagram[5];
+  return detail::decode_fields(datagram[5], datagram[6], datagram[7] == 0, detail::read_u32(&datagram[8]),
+                               &datagram[12], frame);
+}
+
+namespace detail {
+
+std::uint32_t read_u32(const std::uint8_t* bytes) {
+  std::uint32_t v = 0;
+  for (std::size_t i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(bytes[i]) << (8 * i);
+  return v;
+}
+
+Decoded decode_fields(std::uint8_t flags, std::uint8_t dlc, bool reserved_zero, std::uint32_t id,
+                      const std::uint8_t* data, CanFrame& frame) {
   if ((flags & ~(kFlagExtended | kFlagRtr | kFlagError)) != 0) return Decoded::bad_flags;
   const bool error = (flags & kFlagError) != 0;
   if (error && (flags & (kFlagExtended | kFlagRtr)) != 0) return Decoded::bad_flags;
-  if (datagram[7] != 0) return Decoded::bad_reserved;
-  const std::uint8_t dlc = datagram[6];
+  if (!reserved_zero) return Decoded::bad_reserved;
   if (dlc > kCanMaxDlc) return Decoded::bad_dlc;
-  std::uint32_t id = 0;
-  for (std::size_t i = 0; i < 4; ++i) id |= static_cast<std::uint32_t>(datagram[8 + i]) << (8 * i);
 
   CanFrame f;
   f.id = id;
@@ -73,11 +83,13 @@ Decoded decode(std::span<const std::uint8_t> datagram, CanFrame& frame) {
   f.rtr = (flags & kFlagRtr) != 0;
   f.dlc = dlc;
   const std::uint8_t data_bytes = f.rtr ? 0 : dlc;
-  for (std::size_t i = 0; i < data_bytes; ++i) f.data[i] = datagram[12 + i];
+  for (std::size_t i = 0; i < data_bytes; ++i) f.data[i] = data[i];
   if (!error && !is_valid(f)) return Decoded::bad_id;
   if (error && id > kCanExtendedIdMax) return Decoded::bad_id;
   frame = f;
   return error ? Decoded::error_report : Decoded::frame;
 }
+
+}  // namespace detail
 
 }  // namespace tensegrity::fw::udp_can

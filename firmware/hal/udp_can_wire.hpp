@@ -54,4 +54,12 @@ Datagram encode(const CanFrame& frame);
 Datagram encode_error_report(std::uint32_t error_class, const std::array<std::uint8_t, 8>& detail);
 Decoded decode(std::span<const std::uint8_t> datagram, CanFrame& frame);
 
+namespace detail {
+// The checks one frame's fields get in either version (udp_can_batch.hpp): flags,
+// reserved byte(s), dlc, id range. `data` points at 8 bytes.
+Decoded decode_fields(std::uint8_t flags, std::uint8_t dlc, bool reserved_zero, std::uint32_t id,
+                      const std::uint8_t* data, CanFrame& frame);
+std::uint32_t read_u32(const std::uint8_t* bytes);
+}  // namespace detail
+
 }  // namespace tensegrity::fw::udp_can

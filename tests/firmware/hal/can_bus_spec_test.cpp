@@ -25,6 +25,21 @@ TEST(CanBusSpec, ParsesUdpWithAndWithoutBind) {
   EXPECT_EQ(spec.remote.host, "hil.local");
   EXPECT_EQ(spec.bind.host, "127.0.0.1");
   EXPECT_EQ(spec.bind.port, 7001);
+  EXPECT_FALSE(spec.batch);
+}
+
+TEST(CanBusSpec, ParsesBatchInAnyOrder) {
+  CanBusSpec spec;
+  std::string error;
+  ASSERT_TRUE(parse_can_bus_spec("udp:127.0.0.1:7000,batch", spec, error)) << error;
+  EXPECT_TRUE(spec.batch);
+  EXPECT_EQ(spec.bind.port, 0);
+  ASSERT_TRUE(parse_can_bus_spec("udp:127.0.0.1:7000,batch,bind=127.0.0.1:7001", spec, error)) << error;
+  EXPECT_TRUE(spec.batch);
+  EXPECT_EQ(spec.bind.port, 7001);
+  ASSERT_TRUE(parse_can_bus_spec("udp:127.0.0.1:7000,bind=127.0.0.1:7001,batch", spec, error)) << error;
+  EXPECT_TRUE(spec.batch);
+  EXPECT_EQ(spec.bind.port, 7001);
 }
 
 TEST(CanBusSpec, ParsesSocketCan) {
@@ -45,6 +60,8 @@ TEST(CanBusSpec, RejectsBadSpecsWithAReason) {
                         Case{"udp::7000", "missing host"}, Case{"udp:h:70000", "0..65535"},
                         Case{"udp:h:x1", "0..65535"}, Case{"udp:h:0", "must not be 0"},
                         Case{"udp:h:1,foo=1", "unknown option"}, Case{"udp:h:1,bind=h", "bind"},
+                        Case{"udp:h:1,batch,batch", "given twice"}, Case{"udp:h:1,bind=h:2,bind=h:3", "given twice"},
+                        Case{"udp:h:1,", "unknown option"}, Case{"udp:h:1,batch=1", "unknown option"},
                         Case{"socketcan:", "interface name"},
                         Case{"socketcan:a_very_long_interface_name", "interface name"}}) {
     CanBusSpec spec;

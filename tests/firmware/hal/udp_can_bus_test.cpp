@@ -132,7 +132,7 @@ TEST(UdpCanBus, MalformedDatagramsAreDroppedAndCountedByReason) {
   std::vector<std::uint8_t> bad_magic = good;
   bad_magic[0] = 'X';
   std::vector<std::uint8_t> bad_version = good;
-  bad_version[4] = 2;
+  bad_version[4] = 3;  // 1 and 2 exist (udp_can_batch.hpp)
   std::vector<std::uint8_t> dlc9 = good;
   dlc9[6] = 9;
   std::vector<std::uint8_t> id_too_big = good;
