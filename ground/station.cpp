@@ -64,8 +64,21 @@ struct Station::Dds {
   dds::DataWriter* sync_reply = nullptr;
   std::vector<std::unique_ptr<StationListeners::Listener>> listeners;
   std::mutex write_mutex;  // the time-sync reply writer is used from the receive thread
+  // Set (under write_mutex) before anything is deleted: a time-sync request being
+  // answered meanwhile finishes first, a later one is not answered. Without it a
+  // request arriving while a ground tool exited reached through a half-destroyed
+  // object (seen: `tensegrity upload` ending with SIGSEGV after a good upload).
+  bool closed = false;
 
-  ~Dds() { msgs::delete_participant(participant); }
+  ~Dds() { close(); }
+  void close() noexcept {
+    {
+      std::lock_guard lock(write_mutex);
+      closed = true;
+    }
+    msgs::delete_participant(participant);
+    participant = nullptr;
+  }
   dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
     return msgs::create_writer(*participant, *publisher, spec, type);
   }
@@ -114,6 +127,9 @@ Station::~Station() {
   }
   stop_cv_.notify_all();
   if (heartbeat_thread_) heartbeat_thread_->join();
+  // Entities deleted while dds_ still points at them (reset() would null it first,
+  // under the feet of the receive thread's callbacks).
+  dds_->close();
   dds_.reset();
 }
 
@@ -288,6 +304,7 @@ void StationListeners::time_sync(Station& s, dds::DataReader* r) {
     reply.t1_ns(req.t1_ns());
     reply.t2_ns(t2);
     std::lock_guard write_lock(s.dds_->write_mutex);
+    if (s.dds_->closed) return;
     reply.t3_ns(Station::now_ns());
     s.dds_->sync_reply->write(&reply);
     std::lock_guard lock(s.mutex_);

@@ -32,12 +32,26 @@ const char* fault_name(std::uint8_t fault) {
   return "?";
 }
 
-std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns) {
+namespace {
+bool is_expected(std::uint16_t expected, int endcap) { return (expected & (1U << endcap)) != 0; }
+}  // namespace
+
+std::vector<int> missing_endcaps(const std::array<EndcapStatus, kEndcapCount>& status, std::uint16_t expected) {
+  std::vector<int> out;
+  for (int e = 0; e < kEndcapCount; ++e) {
+    if (is_expected(expected, e) && !status[static_cast<std::size_t>(e)].seen) out.push_back(e);
+  }
+  return out;
+}
+
+std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns,
+                                std::uint16_t expected) {
   std::string out =
       "endcap  hb_age_s  policy                    state    fault           tension_n        offset_ms  rtt_ms  "
       "host\n";
   char line[512];
   for (int e = 0; e < kEndcapCount; ++e) {
+    if (!is_expected(expected, e)) continue;
     const EndcapStatus& s = status[static_cast<std::size_t>(e)];
     if (!s.seen) {
       std::snprintf(line, sizeof line, "%6d  %8s  (no heartbeat)\n", e, "-");
@@ -65,9 +79,11 @@ std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& st
   return out;
 }
 
-std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns) {
+std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns,
+                               std::uint16_t expected) {
   nlohmann::json endcaps = nlohmann::json::array();
   for (int e = 0; e < kEndcapCount; ++e) {
+    if (!is_expected(expected, e)) continue;
     const EndcapStatus& s = status[static_cast<std::size_t>(e)];
     nlohmann::json j{{"endcap", e}, {"seen", s.seen}};
     if (s.seen) {
@@ -94,7 +110,7 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
     }
     endcaps.push_back(j);
   }
-  return nlohmann::json{{"endcaps", endcaps}}.dump(2);
+  return nlohmann::json{{"endcaps", endcaps}, {"missing", missing_endcaps(status, expected)}}.dump(2);
 }
 
 }  // namespace tensegrity::ground

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <mutex>
 
+#include "msgs/link_cut_transport.hpp"
+
 namespace tensegrity::msgs {
 
 extern const std::string_view kQosProfilesXml;
@@ -47,7 +49,7 @@ void load_qos_profiles() {
   if (!error.empty()) throw DdsError(error);
 }
 
-dds::DomainParticipant* create_participant(int domain, const std::string& name) {
+dds::DomainParticipant* create_participant(int domain, const std::string& name, const std::atomic<bool>* link_cut) {
   load_qos_profiles();
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos qos;
@@ -55,6 +57,9 @@ dds::DomainParticipant* create_participant(int domain, const std::string& name) 
     throw DdsError(std::string("QoS profile '") + kParticipantProfile + "' not found");
   }
   qos.name(name);
+  if (link_cut != nullptr) {
+    for (auto& transport : qos.transport().user_transports) transport = make_link_cut_transport(transport, link_cut);
+  }
   dds::DomainParticipant* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain), qos);
   if (participant == nullptr) {
     throw DdsError("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain));
@@ -70,6 +75,12 @@ void delete_participant(dds::DomainParticipant* participant) noexcept {
 
 dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& spec, dds::TypeSupport type) {
   if (participant.find_type(spec.type).empty()) {
+    // No XTypes TypeInformation (PID 0x75) in our endpoints' discovery data: Fast
+    // DDS 2.9 encodes it without the XCDR2 headers XTypes 1.3 requires, and a
+    // compliant peer (Cyclone DDS 0.10) then drops the whole announcement, so the
+    // topic never matches. Fast DDS peers match on the type name and the older
+    // TypeObject (still sent); see docs/dds.md "A second vendor: Cyclone DDS".
+    type->auto_fill_type_information(false);
     if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) {
       throw DdsError(std::string("cannot register type ") + spec.type);
     }

@@ -13,6 +13,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -67,8 +68,11 @@ inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyA
 void load_qos_profiles();
 
 // A participant on `domain` with the UDP-only profile; throws DdsError on failure.
-// Delete with delete_participant (deletes its entities first).
-eprosima::fastdds::dds::DomainParticipant* create_participant(int domain, const std::string& name);
+// Delete with delete_participant (deletes its entities first). With `link_cut`,
+// its transport drops every datagram in and out while *link_cut is true (fault
+// injection: msgs/link_cut_transport.hpp); the flag must outlive the participant.
+eprosima::fastdds::dds::DomainParticipant* create_participant(int domain, const std::string& name,
+                                                              const std::atomic<bool>* link_cut = nullptr);
 void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
 
 // Registers `type` (once per participant) and creates the topic of `spec`.

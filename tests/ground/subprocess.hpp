@@ -58,23 +58,44 @@ class Subprocess {
     }
     return false;
   }
+  // Waits for the child to exit by itself: its exit code, 128 + the signal that
+  // ended it (as a shell reports it), or -1 when it is still running at `timeout`
+  // (then it is killed).
+  int wait_exit(std::chrono::milliseconds timeout) {
+    if (pid_ <= 0) return -1;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    int status = 0;
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    kill_hard();
+    return -1;
+  }
   void kill_hard() {
     if (pid_ <= 0) return;
     ::kill(pid_, SIGKILL);
     ::waitpid(pid_, nullptr, 0);
     pid_ = -1;
   }
-  void stop() {
-    if (pid_ <= 0) return;
+  // SIGTERM, then SIGKILL after 3 s. Its exit code, 128 + the signal that ended it,
+  // or -1 when it had to be killed (or was not running).
+  int stop() {
+    if (pid_ <= 0) return -1;
     ::kill(pid_, SIGTERM);
     for (int i = 0; i < 300; ++i) {
-      if (::waitpid(pid_, nullptr, WNOHANG) == pid_) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
         pid_ = -1;
-        return;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     kill_hard();
+    return -1;
   }
 
  private:

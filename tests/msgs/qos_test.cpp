@@ -114,6 +114,8 @@ TEST(Qos, DurableAndStreamProfilesAreWhatTheDesignSays) {
   ASSERT_EQ(pub->get_datawriter_qos_from_profile(kProfileDurable, q), ReturnCode_t::RETCODE_OK);
   EXPECT_EQ(q.reliability().kind, dds::RELIABLE_RELIABILITY_QOS);
   EXPECT_EQ(q.durability().kind, dds::TRANSIENT_LOCAL_DURABILITY_QOS);
+  // A lost table or ack is repaired within 0.1 s, not Fast DDS's default 3 s.
+  EXPECT_EQ(q.reliable_writer_qos().times.heartbeatPeriod, eprosima::fastrtps::Duration_t(0, 100'000'000));
   ASSERT_EQ(pub->get_datawriter_qos_from_profile(kProfileStream, q), ReturnCode_t::RETCODE_OK);
   EXPECT_EQ(q.reliability().kind, dds::BEST_EFFORT_RELIABILITY_QOS);
   EXPECT_EQ(q.durability().kind, dds::VOLATILE_DURABILITY_QOS);
