@@ -1,17 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
 // `tensegrity evolve`: cooperative coevolution of a policy on the model (paper,
-// Algorithm 1), checkpointed after every generation, resumable after any kill.
+// Algorithm 1), checkpointed after every generation, resumable after any kill;
+// evaluated on threads, or with --mpi on the ranks of an MPI job (cli/evolve_mpi).
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/evolve_mpi.hpp"
 #include "cli/evolve_progress.hpp"
 #include "sim/evolve/checkpoint.hpp"
 #include "sim/evolve/driver.hpp"
@@ -38,6 +41,9 @@ struct EvolveArgs {
   std::string out;
   std::string log;
   bool json = false;
+  bool mpi = false;
+  int mpi_root_threads = -1;
+  double mpi_timeout_s = 600.0;
 };
 
 int default_threads() {
@@ -45,8 +51,31 @@ int default_threads() {
   return n == 0 ? 1 : static_cast<int>(n);
 }
 
-void run_evolve(const EvolveArgs& args) {
-  const sim::Robot robot = load_robot_arg(args.robot);
+// The description's text as well as the robot: MPI ranks get the text, so that they
+// need no copy of the file and cannot read a different one.
+struct RobotArg {
+  std::string text;
+  sim::Robot robot;
+};
+
+RobotArg read_robot_arg(const std::string& arg) {
+  const std::filesystem::path path = arg.empty() ? sim::default_robot_path() : std::filesystem::path(arg);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CommandError(2, path.string() + ": cannot open robot description");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    sim::Robot robot = sim::parse_robot(text.str(), path.string());
+    return RobotArg{text.str(), std::move(robot)};
+  } catch (const sim::RobotError& e) {
+    throw CommandError(2, e.what());
+  }
+}
+
+// `mpi` is rank 0's side of an MPI run; null: evaluate on this machine's threads.
+void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
+  const RobotArg robot_arg = read_robot_arg(args.robot);
+  const sim::Robot& robot = robot_arg.robot;
   sim::evolve::EvolveConfig config;
   try {
     config.method = sim::evolve::parse_fitness_method(args.method);
@@ -77,8 +106,14 @@ void run_evolve(const EvolveArgs& args) {
   const std::filesystem::path out_path(args.out);
   if (out_path.has_parent_path()) std::filesystem::create_directories(out_path.parent_path());
 
-  const int threads = args.threads > 0 ? args.threads : default_threads();
-  auto evaluator = sim::evolve::make_episode_evaluator(robot, config, threads);
+  std::unique_ptr<sim::evolve::Evaluator> threaded;
+  int threads = 0;
+  if (mpi == nullptr) {
+    threads = args.threads > 0 ? args.threads : default_threads();
+    threaded = sim::evolve::make_episode_evaluator(robot, config, threads);
+  }
+  sim::evolve::Evaluator& evaluator = mpi != nullptr ? mpi->evaluator(robot_arg.text, robot, config) : *threaded;
+  if (mpi != nullptr) threads = mpi->threads();
   EvolveProgress progress(isatty(STDERR_FILENO) == 1, config.episodes);
 
   sim::evolve::DriverOptions options;
@@ -91,7 +126,7 @@ void run_evolve(const EvolveArgs& args) {
   const auto started = std::chrono::steady_clock::now();
   sim::evolve::DriverResult result = [&] {
     try {
-      return sim::evolve::drive(config, *evaluator, options);
+      return sim::evolve::drive(config, evaluator, options);
     } catch (const sim::evolve::CheckpointError& e) {
       throw CommandError(3, e.what());
     }
@@ -104,7 +139,7 @@ void run_evolve(const EvolveArgs& args) {
   // The best team once more, alone: its score and feasibility as the policy file
   // reports them (the model is deterministic, so this confirms the recorded score).
   const std::vector<sim::evolve::Team> final_team{best.team};
-  const sim::evolve::TeamResult final_result = evaluator->evaluate(final_team).front();
+  const sim::evolve::TeamResult final_result = evaluator.evaluate(final_team).front();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, best.team);
@@ -119,7 +154,7 @@ void run_evolve(const EvolveArgs& args) {
   const double rate = wall_s > 0.0 ? static_cast<double>(episodes_here) / wall_s : 0.0;
   const double infeasible_last = evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate();
   if (args.json) {
-    const nlohmann::json j = {{"best_score_m", best.score_m},
+    nlohmann::json j = {{"best_score_m", best.score_m},
                               {"best_feasible", best.feasible},
                               {"final_score_m", final_result.score_m},
                               {"final_feasible", final_result.feasible},
@@ -128,10 +163,12 @@ void run_evolve(const EvolveArgs& args) {
                               {"infeasible_rate_last", infeasible_last},
                               {"resumed", result.resumed},
                               {"threads", threads},
+                              {"ranks", mpi != nullptr ? mpi->ranks() : 1},
                               {"wall_time_s", wall_s},
                               {"episodes_per_s", rate},
                               {"out", args.out},
                               {"log", args.log}};
+    if (mpi != nullptr) j["rank_loads"] = mpi->loads();
     std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("evolve %s: %d generations, %lld episodes%s\n", policy.provenance.method.c_str(), evo.generation(),
@@ -139,7 +176,15 @@ void run_evolve(const EvolveArgs& args) {
     std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
                 final_result.score_m, final_result.feasible ? "" : " INFEASIBLE");
     std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
-    std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads\n", wall_s, rate, threads);
+    std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", wall_s, rate, threads);
+    if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
+    std::printf("\n");
+    if (mpi != nullptr) {
+      for (const auto& r : mpi->loads()) {
+        std::printf("    rank %d  %-20s %3d threads  %lld teams\n", r["rank"].get<int>(),
+                    r["host"].get<std::string>().c_str(), r["threads"].get<int>(), r["teams"].get<long long>());
+      }
+    }
     std::printf("  policy     %s\n  curve      %s\n", args.out.c_str(), args.log.c_str());
   }
 }
@@ -156,11 +201,14 @@ void add_evolve_command(CLI::App& app) {
       ->check(CLI::IsMember({"historical", "leniency", "average"}));
   cmd->add_option("--episodes", args->episodes, "Episode budget")->capture_default_str()->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "Random seed (the run depends on it alone)")->capture_default_str();
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores); results do not depend on it")
+  cmd->add_option("--threads", args->threads,
+                  "Worker threads (default: all cores; with --mpi per rank, the CPUs it may use); results do not "
+                  "depend on it")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--checkpoint", args->checkpoint, "Directory for a checkpoint after every generation");
   cmd->add_flag("--resume", args->resume, "Continue the run checkpointed in --checkpoint");
-  cmd->add_option("--robot", args->robot, "Robot description")->check(CLI::ExistingFile);
+  // Not checked by the parser: with --mpi only rank 0 reads it, the other machines need no copy.
+  cmd->add_option("--robot", args->robot, "Robot description");
   cmd->add_option("--population", args->population, "Members per cable population")->capture_default_str()->check(CLI::Range(2, 100000));
   cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
@@ -169,9 +217,26 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");
+  cmd->add_flag("--mpi", args->mpi,
+                "Evaluate on the ranks of an MPI job (mpirun -np N tensegrity evolve ... --mpi): rank 0 evolves, "
+                "the others only evaluate; results do not depend on it");
+  cmd->add_option("--mpi-root-threads", args->mpi_root_threads,
+                  "With --mpi: rank 0's evaluating threads (default: --threads; 0: rank 0 only hands out teams)")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--mpi-timeout", args->mpi_timeout_s,
+                  "With --mpi: fail the run when a rank holding a team answers nothing for this many seconds "
+                  "(0: wait forever)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
   cmd->callback([args] {
     if (args->resume && args->checkpoint.empty()) throw CommandError(2, "--resume needs --checkpoint DIR");
-    run_evolve(*args);
+    check_evolve_launch(args->mpi);
+    if (!args->mpi) {
+      run_evolve(*args, nullptr);
+      return;
+    }
+    const EvolveMpiArgs mpi_args{args->threads, args->mpi_root_threads, args->mpi_timeout_s};
+    run_evolve_mpi(mpi_args, [&](EvolveMpi& mpi) { run_evolve(*args, &mpi); });
   });
 }
 

@@ -28,7 +28,7 @@ TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, do
   return TeamResult{result.feasible ? result.distance_m : 0.0, result.feasible};
 }
 
-std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads) {
+TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config) {
   if (robot.cable_count() != config.cables) {
     throw ConfigError("robot has " + std::to_string(robot.cable_count()) + " cables, config " +
                       std::to_string(config.cables));
@@ -38,11 +38,13 @@ std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const Evol
   const double period_s = config.period_s;
   const int complexity = config.complexity;
   const double duration_s = config.duration_s;
-  return std::make_unique<ParallelEvaluator>(
-      [shared, period_s, complexity, duration_s](const Team& team) {
-        return evaluate_team(*shared, period_s, complexity, duration_s, team);
-      },
-      threads);
+  return [shared, period_s, complexity, duration_s](const Team& team) {
+    return evaluate_team(*shared, period_s, complexity, duration_s, team);
+  };
+}
+
+std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads) {
+  return std::make_unique<ParallelEvaluator>(episode_team_function(robot, config), threads);
 }
 
 }  // namespace tensegrity::sim::evolve

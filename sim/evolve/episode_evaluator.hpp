@@ -20,6 +20,11 @@ Policy team_policy(const Robot& robot, double period_s, int complexity, const Te
 // One episode of `duration_s` from the settled start. Thread-safe.
 TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, const Team& team);
 
+// evaluate_team with the config's episode settings, as a thread-safe function that
+// keeps its own copy of the robot. Throws ConfigError when the robot does not fit the
+// config. Every evaluator of episodes (threads, MPI ranks) scores with this.
+TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config);
+
 // The episode scorer on `threads` workers (each worker runs whole episodes).
 std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads);
 
