@@ -104,6 +104,8 @@ void EndcapDevices::preferred(std::span<const double> rest_length_m, std::span<d
     const int c = cables_[m];
     if (released_[m]) {
       preferred_m[c] = max_rest_length_m_;
+    } else if (seized_[m]) {
+      preferred_m[c] = rest_length_m[c];
     } else if (drives_[m].follows_target()) {
       preferred_m[c] = spool_.rest_length_from_counts(drives_[m].target_counts());
     } else {

@@ -70,6 +70,12 @@ class EndcapDevices {
   // Fault injection.
   void fault_drive(std::size_t motor, std::uint16_t code, bool release, std::int64_t now_ns, FrameOut& out);
   void silence_drive(std::size_t motor, bool silent);
+  // The spool runs free while the drive carries on unaware (a slipping clutch, a
+  // snapped cable): the cable pays out as a released one does, no EMCY.
+  void release_spool(std::size_t motor) { released_.at(motor) = true; }
+  // The spool seizes (a jammed gearbox): the cable keeps its length, the drive
+  // carries on unaware.
+  void seize_spool(std::size_t motor) { seized_.at(motor) = true; }
   void set_load_cell_stuck(bool stuck) { load_cell_.set_stuck(stuck); }
   void start_load_cell_drift(double n_per_s, std::int64_t now_ns) { load_cell_.start_drift(n_per_s, now_ns); }
 
@@ -87,6 +93,7 @@ class EndcapDevices {
   SimLoadCell load_cell_{kLoadCellNodeId};
   std::array<bool, 4> rpdo_seen_{};
   std::array<bool, 4> released_{};
+  std::array<bool, 4> seized_{};
 };
 
 }  // namespace tensegrity::hil

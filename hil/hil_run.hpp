@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // One whole HIL run, as `tensegrity hil` and the tests do it: the emulator's hub,
-// twelve end-cap programs, provisioning, boot to the start gate, an in-phase
-// start, the run, a clean shutdown and a summary. Errors become
-// HilResult::error (the reason), never a hang or an orphan process.
+// twelve end-cap programs, boot to the start gate, provisioning (over DDS as on the
+// robot, or locally), an in-phase start, the run, a clean shutdown and a summary
+// with each end cap's table phase. Errors become HilResult::error (the reason),
+// never a hang or an orphan process. docs/hil.md.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,15 @@ namespace tensegrity::hil {
 
 class ProcessLauncher;
 
+// How the policy reaches the end caps and how they are started (provisioner.hpp).
+enum class Provision : std::uint8_t {
+  dds,    // over DDS, as on the robot: upload + start command (dds_provisioner.hpp)
+  local,  // --policy FILE --start-on-boot --no-dds and the stepper's start gate
+};
+const char* to_string(Provision provision);
+// The default: dds when this build has the DDS link.
+Provision default_provision();
+
 struct HilOptions {
   std::filesystem::path robot;  // empty: the default robot
   std::filesystem::path policy;
@@ -30,8 +41,14 @@ struct HilOptions {
   std::filesystem::path endcap_binary;  // empty: default_endcap_binary()
   double barrier_timeout_s = 2.0;
   double boot_timeout_s = 30.0;
+  Provision provision = default_provision();
+  std::string host_loss = "continue";  // the end caps' --host-loss (dds)
+  int dds_domain = -1;                 // -1: a free one of the HIL's range (dds_domain.hpp)
+  double hold_timeout_s = 60.0;        // dds: gate open to physics step 0
   bool keep_dir = false;
+  double dds_discovery_timeout_s = 15.0;  // dds: every end cap on the link, clock synchronized
   std::vector<int> never_start;  // tests
+  std::map<int, std::vector<std::string>> endcap_extra_args;  // tests: more arguments for an end cap
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).
   std::function<void(ProcessLauncher&)> after_launch;
   std::function<void(const WorldStepper&, ProcessLauncher&)> after_step;
@@ -49,6 +66,15 @@ struct EndcapSummary {
   // From the emulator's side of its bus.
   BusCounters bus;
   EndcapDeviceSummary devices;
+  // Table phase at the end of the run relative to the median of the end caps
+  // playing (wrapped to +- half a period); absent if it was not playing. Lockstep:
+  // table times at the last SYNC; real time: CLOCK_MONOTONIC instants of table time 0.
+  bool playing = false;
+  double phase_offset_s = 0.0;
+  // From its log: host losses seen, DDS link cuts (fault injection).
+  int host_losses = 0;
+  int host_returns = 0;
+  int link_cuts = 0;
 };
 
 struct HilResult {
@@ -62,6 +88,8 @@ struct HilResult {
   std::vector<std::string> log;
   double wall_s = 0.0;
   std::string provisioner;
+  double max_phase_offset_s = 0.0;  // over the end caps playing at the end
+  int playing = 0;                  // end caps playing their table at the end
   std::uint64_t hub_syscalls = 0;
   bool emulator_realtime_priority = false;  // SCHED_FIFO above the end caps' loops
 };

@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <sched.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -56,7 +57,7 @@ fs::path default_endcap_binary() {
 #endif
 }
 
-ProcessLauncher::ProcessLauncher(const LauncherConfig& config, const Provisioner& provisioner)
+ProcessLauncher::ProcessLauncher(const LauncherConfig& config, Provisioner& provisioner)
     : config_(config), provisioner_(provisioner), slots_(config.endcap_count) {
   if (!fs::exists(config_.endcap_binary)) {
     throw HilError("end-cap program not found: " + config_.endcap_binary.string() +
@@ -80,7 +81,9 @@ ProcessLauncher::ProcessLauncher(const LauncherConfig& config, const Provisioner
     const auto& l = config_.limits;
     const nlohmann::json j = {
         {"format", "tensegrity-endcap/1"},
-        {"bus", "udp:127.0.0.1:" + std::to_string(config_.hub_port) + ",bind=127.0.0.1:" + std::to_string(s.port)},
+        // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
+        {"bus", "udp:127.0.0.1:" + std::to_string(config_.hub_port) + ",bind=127.0.0.1:" + std::to_string(s.port) +
+                    ",batch"},
         {"nodes", {{"drives", drives}, {"load_cell", kLoadCellNodeId}}},
         {"spool", {{"radius_m", config_.spool.spool_radius_m}, {"counts_per_rev", config_.spool.counts_per_rev}}},
         {"limits",
@@ -122,6 +125,9 @@ void ProcessLauncher::spawn(int e, bool restart) {
   std::vector<std::string> args{config_.endcap_binary.string(), "--id", std::to_string(e), "--config", s.config.string(),
                                 "--stats-json", s.stats.string()};
   for (auto& a : provisioner_.endcap_arguments(e, restart)) args.push_back(std::move(a));
+  if (const auto extra = config_.extra_args.find(e); extra != config_.extra_args.end()) {
+    args.insert(args.end(), extra->second.begin(), extra->second.end());
+  }
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -138,6 +144,12 @@ void ProcessLauncher::spawn(int e, bool restart) {
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent) ::_exit(127);  // the launcher died before prctl
     ::setpgid(0, 0);
+    // A restart is spawned by the stepper's thread, which runs SCHED_FIFO: the
+    // program must not inherit that (its start-up, DDS participant included, would
+    // outrank every end cap's loop and stall the stepper for most of a second).
+    // The program raises its own loop thread's priority.
+    const sched_param normal{};
+    ::sched_setscheduler(0, SCHED_OTHER, &normal);
     ::dup2(log_fd, 1);
     ::dup2(log_fd, 2);
     ::execv(argv[0], argv.data());
@@ -229,20 +241,67 @@ void ProcessLauncher::kill(int e) {
 void ProcessLauncher::restart(int e) {
   kill(e);
   spawn(e, true);
+  provisioner_.on_restart(e);
 }
 
-std::vector<EndcapProcessReport> ProcessLauncher::shutdown() {
-  if (shut_down_) return reports_;
-  shut_down_ = true;
-  std::vector<double> cpu(slots_.size());
+namespace {
+// Whether process `pid` has a handler for `signal` (SigCgt in /proc/PID/status):
+// until the program installed it, the signal's default action would end it.
+bool catches(pid_t pid, int signal) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("SigCgt:", 0) != 0) continue;
+    try {
+      const unsigned long long mask = std::stoull(line.substr(7), nullptr, 16);
+      return ((mask >> (signal - 1)) & 1ULL) != 0;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  return false;
+}
+}  // namespace
+
+std::string ProcessLauncher::set_dds_link(int e, bool up) {
+  if (!provisioner_.dds_link()) return "this run has no DDS link (provisioner " + provisioner_.name() + ")";
+  reap(e, false);
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) return "not running";
+  const int signal = up ? SIGUSR2 : SIGUSR1;
+  if (!catches(s.pid, signal)) return "its program does not handle the link signals (yet)";
+  if (::kill(s.pid, signal) != 0) return std::string("kill: ") + std::strerror(errno);
+  return "";
+}
+
+void ProcessLauncher::terminate_all() {
+  if (!terminate_cpu_s_.empty()) return;
+  terminate_cpu_s_.resize(slots_.size());
   for (int e = 0; e < endcap_count(); ++e) {
-    cpu[e] = cpu_s(e);
+    terminate_cpu_s_[e] = cpu_s(e);  // /proc/PID is gone once it exits
     if (slots_[e].pid > 0) {
       ::kill(-slots_[e].pid, SIGCONT);  // a stopped one could not act on SIGTERM
       ::kill(-slots_[e].pid, SIGTERM);
     }
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+}
+
+bool ProcessLauncher::all_exited() {
+  bool alive = false;
+  for (int e = 0; e < endcap_count(); ++e) {
+    reap(e, false);
+    alive = alive || slots_[e].pid > 0;
+  }
+  return !alive;
+}
+
+std::vector<EndcapProcessReport> ProcessLauncher::shutdown() {
+  if (shut_down_) return reports_;
+  shut_down_ = true;
+  terminate_all();
+  const std::vector<double> cpu = terminate_cpu_s_;
+  // Generous: on a host loaded by other real-time work a program's housekeeping
+  // thread may wait seconds for a core, and a SIGKILL loses its stats.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   for (;;) {
     bool alive = false;
     for (int e = 0; e < endcap_count(); ++e) {

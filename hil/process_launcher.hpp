@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct LauncherConfig {
   core::MotorLimits limits;
   bool keep_dir = false;          // leave configs, stores and logs behind (debugging)
   std::vector<int> never_start;   // tests: end caps whose program is not started
+  std::map<int, std::vector<std::string>> extra_args;  // tests: appended to an end cap's arguments
 };
 
 struct EndcapProcessReport {
@@ -46,7 +48,7 @@ struct EndcapProcessReport {
 
 class ProcessLauncher final : public EndcapProcesses {
  public:
-  ProcessLauncher(const LauncherConfig& config, const Provisioner& provisioner);
+  ProcessLauncher(const LauncherConfig& config, Provisioner& provisioner);
   ~ProcessLauncher() override;
   ProcessLauncher(const ProcessLauncher&) = delete;
   ProcessLauncher& operator=(const ProcessLauncher&) = delete;
@@ -65,8 +67,15 @@ class ProcessLauncher final : public EndcapProcesses {
   std::string describe(int endcap) override;
   void kill(int endcap) override;
   void restart(int endcap) override;
+  // SIGUSR1 (cut) / SIGUSR2 (restore) to a program started with --dds-cut-signals.
+  std::string set_dds_link(int endcap, bool up) override;
 
-  // SIGTERM, wait (then SIGKILL), collect stats; idempotent.
+  // SIGTERM to every end cap, without waiting (so the emulator can keep serving
+  // their buses while they stop); idempotent.
+  void terminate_all();
+  // Every end cap's program has exited (reaps them).
+  bool all_exited();
+  // terminate_all(), wait (then SIGKILL), collect stats; idempotent.
   std::vector<EndcapProcessReport> shutdown();
 
  private:
@@ -82,10 +91,11 @@ class ProcessLauncher final : public EndcapProcesses {
   void reap(int endcap, bool block);
 
   LauncherConfig config_;
-  const Provisioner& provisioner_;
+  Provisioner& provisioner_;
   std::filesystem::path dir_;
   std::vector<Slot> slots_;
   std::vector<EndcapProcessReport> reports_;
+  std::vector<double> terminate_cpu_s_;  // CPU seconds when terminate_all() ran
   bool shut_down_ = false;
 };
 

@@ -7,7 +7,7 @@
 namespace tensegrity::hil {
 
 std::vector<std::string> LocalProvisioner::endcap_arguments(int, bool restart) const {
-  // Local provisioning needs no host link; the DDS provisioner will drop --no-dds.
+  // Local provisioning needs no host link.
   if (restart) return {"--no-dds", "--start-on-boot"};
   return {"--no-dds", "--policy", policy_.string(), "--start-on-boot"};
 }

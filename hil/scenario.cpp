@@ -14,7 +14,7 @@ namespace tensegrity::hil {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 10> kNames{{
+constexpr std::array<std::pair<FaultKind, const char*>, 12> kNames{{
     {FaultKind::drive_fault, "drive_fault"},
     {FaultKind::drive_silent, "drive_silent"},
     {FaultKind::load_cell_stuck, "load_cell_stuck"},
@@ -25,6 +25,8 @@ constexpr std::array<std::pair<FaultKind, const char*>, 10> kNames{{
     {FaultKind::restart_endcap, "restart_endcap"},
     {FaultKind::cut_dds, "cut_dds"},
     {FaultKind::restore_dds, "restore_dds"},
+    {FaultKind::release_spool, "release_spool"},
+    {FaultKind::seize_spool, "seize_spool"},
 }};
 
 FaultKind fault_from_name(const std::string& name, const std::string& where) {
@@ -92,13 +94,16 @@ const char* to_string(FaultKind kind) {
 
 std::string ScenarioEvent::describe() const {
   std::ostringstream s;
-  s << "t=" << time_s << " s end cap " << endcap << ": " << to_string(fault);
+  s << "t=" << time_s << " s " << (endcap < 0 ? std::string("all end caps") : "end cap " + std::to_string(endcap)) << ": "
+    << to_string(fault);
   switch (fault) {
     case FaultKind::drive_fault:
       s << " (motor " << params.motor << ", EMCY 0x" << std::hex << params.code << std::dec
         << (params.release ? ", released" : ", holding") << ")";
       break;
-    case FaultKind::drive_silent: s << " (motor " << params.motor << ")"; break;
+    case FaultKind::drive_silent:
+    case FaultKind::release_spool:
+    case FaultKind::seize_spool: s << " (motor " << params.motor << ")"; break;
     case FaultKind::load_cell_drift: s << " (" << params.n_per_s << " N/s)"; break;
     case FaultKind::drop_frames:
     case FaultKind::corrupt_frames:
@@ -155,6 +160,8 @@ Scenario parse_scenario(const std::string& text, int endcap_count, const std::st
       check_endcap(ev.endcap, endcap_count, where + ".endcap");
     } else if (needs_endcap) {
       throw HilError(where + ".endcap: required for " + to_string(ev.fault));
+    } else {
+      ev.endcap = -1;  // the link of every end cap: the host's own link is cut
     }
     ev.params = parse_params(e.contains("params") ? e["params"] : nlohmann::json(), where);
     scenario.events.push_back(ev);
@@ -171,6 +178,24 @@ Scenario load_scenario(const std::filesystem::path& path, int endcap_count) {
   return parse_scenario(s.str(), endcap_count, path.string());
 }
 
+ScenarioEvent disabled_cable_event(const sim::Robot& robot, int cable, CableFailure failure) {
+  if (cable < 0 || cable >= robot.cable_count()) {
+    throw HilError("cable " + std::to_string(cable) + ": the robot has cables 0.." + std::to_string(robot.cable_count() - 1));
+  }
+  ScenarioEvent ev;
+  ev.time_s = 0.0;
+  ev.endcap = robot.cables[static_cast<std::size_t>(cable)].owner;
+  ev.fault = failure == CableFailure::drive   ? FaultKind::drive_fault
+             : failure == CableFailure::spool ? FaultKind::release_spool
+                                              : FaultKind::seize_spool;
+  const auto& mine = robot.cables_of(ev.endcap);
+  for (std::size_t m = 0; m < mine.size(); ++m) {
+    if (mine[m] == cable) ev.params.motor = static_cast<int>(m);
+  }
+  ev.params.release = true;
+  return ev;
+}
+
 ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
   const auto colon = text.find(':');
   const auto at = text.find('@');
@@ -178,14 +203,25 @@ ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
     throw HilError("--fault '" + text + "': expected ENDCAP:FAULT@TIME_S, e.g. 3:drive_fault@2.0");
   }
   ScenarioEvent ev;
-  try {
-    ev.endcap = std::stoi(text.substr(0, colon));
-    ev.time_s = std::stod(text.substr(at + 1));
-  } catch (const std::exception&) {
-    throw HilError("--fault '" + text + "': ENDCAP and TIME_S must be numbers");
-  }
-  check_endcap(ev.endcap, endcap_count, "--fault '" + text + "'");
   ev.fault = fault_from_name(text.substr(colon + 1, at - colon - 1), "--fault '" + text + "'");
+  const bool all_allowed = ev.fault == FaultKind::cut_dds || ev.fault == FaultKind::restore_dds;
+  const std::string who = text.substr(0, colon);
+  try {
+    std::size_t used = 0;
+    const std::string when = text.substr(at + 1);
+    ev.time_s = std::stod(when, &used);
+    if (used != when.size() || !(ev.time_s >= 0.0)) throw std::invalid_argument(when);
+    if (who == "all" && all_allowed) {
+      ev.endcap = -1;
+    } else {
+      ev.endcap = std::stoi(who, &used);
+      if (used != who.size()) throw std::invalid_argument(who);
+    }
+  } catch (const std::exception&) {
+    throw HilError("--fault '" + text + "': ENDCAP must be a number" + std::string(all_allowed ? " or 'all'" : "") +
+                   " and TIME_S a number >= 0");
+  }
+  if (ev.endcap >= 0) check_endcap(ev.endcap, endcap_count, "--fault '" + text + "'");
   return ev;
 }
 

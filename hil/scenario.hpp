@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "hil/udp_hub.hpp"
+#include "sim/robot.hpp"
 
 namespace tensegrity::hil {
 
@@ -25,8 +26,10 @@ enum class FaultKind : std::uint8_t {
   corrupt_frames,   // frames to the end cap corrupted; params: probability, duration_s, kind
   kill_endcap,      // SIGKILL the end cap's process
   restart_endcap,   // start it again (stored policy, start on boot); it rejoins in phase
-  cut_dds,          // needs the DDS link: reported as not done yet
-  restore_dds,
+  cut_dds,          // the end cap's DDS link to the host is cut (every datagram in and out); no endcap: all
+  restore_dds,      // ... and restored
+  release_spool,    // the spool runs free, the drive does not notice; params: motor
+  seize_spool,      // the spool seizes (cable length frozen), the drive does not notice; params: motor
 };
 
 const char* to_string(FaultKind kind);
@@ -46,7 +49,7 @@ struct FaultParams {
 
 struct ScenarioEvent {
   double time_s = 0.0;
-  int endcap = 0;
+  int endcap = 0;  // -1: every end cap (cut_dds, restore_dds only)
   FaultKind fault = FaultKind::drive_fault;
   FaultParams params;
   std::string describe() const;
@@ -59,8 +62,18 @@ struct Scenario {
 // Errors (std::runtime_error, via HilError) name the source and the event index.
 Scenario parse_scenario(const std::string& json_text, int endcap_count, const std::string& source = "scenario");
 Scenario load_scenario(const std::filesystem::path& path, int endcap_count);
-// "ENDCAP:FAULT@TIME_S" (params default), e.g. "3:drive_fault@2.0".
+// "ENDCAP:FAULT@TIME_S" (params default), e.g. "3:drive_fault@2.0"; ENDCAP "all"
+// for cut_dds and restore_dds.
 ScenarioEvent parse_fault_option(const std::string& text, int endcap_count);
 void sort_events(Scenario& scenario);
+// How a disabled cable fails (tensegrity hil --cable-failure).
+enum class CableFailure : std::uint8_t {
+  drive,  // its drive faults (EMCY) and releases it: slack; its end cap goes to its safe state (other cable held)
+  spool,  // only the spool runs free (release_spool): slack; the end cap keeps playing its other cable
+  seize,  // only the spool seizes (seize_spool): the cable keeps its start length; the end cap plays on
+};
+// Muscle failure from the start (the paper's Figure 13): cable `cable`, on the end
+// cap that owns it, fails at time 0 in the given way. Throws HilError for a bad index.
+ScenarioEvent disabled_cable_event(const sim::Robot& robot, int cable, CableFailure failure = CableFailure::drive);
 
 }  // namespace tensegrity::hil

@@ -7,6 +7,7 @@
 
 #include "firmware/drivers/pdo_codec.hpp"
 #include "hil/hil_error.hpp"
+#include "hil/pacer.hpp"
 
 namespace tensegrity::hil {
 
@@ -75,13 +76,17 @@ bool WorldStepper::all_at_gate() const {
   return true;
 }
 
-void WorldStepper::route(const std::vector<UdpHub::Rx>& rx) {
+void WorldStepper::serve(const std::vector<UdpHub::Rx>& rx) {
   const std::int64_t now = now_device_ns();
   for (const UdpHub::Rx& r : rx) {
     endcaps_[r.endcap].devices.on_frame(r.frame, now, out_);
     for (const CanFrame& f : out_) hub_.queue(r.endcap, f);
     out_.clear();
   }
+}
+
+void WorldStepper::route(const std::vector<UdpHub::Rx>& rx) {
+  serve(rx);
   hub_.flush();
 }
 
@@ -127,10 +132,15 @@ void WorldStepper::lockstep_tick(bool physics) {
 
 void WorldStepper::barrier(std::int64_t tick) {
   const std::int64_t start = monotonic_ns();
-  bool first = false;
-  for (const Endcap& ec : endcaps_) first = first || (ec.expected && ec.first_answer_pending);
+  bool first = false, expected = false;
+  for (const Endcap& ec : endcaps_) {
+    first = first || (ec.expected && ec.first_answer_pending);
+    expected = expected || ec.expected;
+  }
   const std::int64_t timeout = first ? config_.first_answer_timeout_ns : config_.barrier_timeout_ns;
   const std::int64_t deadline = start + timeout;
+  hub_.reset_latest_arrival();
+  if (expected && !first) pace_until(start + nap_.nap_ns(), 0);
   for (;;) {
     bool done = true;
     for (const Endcap& ec : endcaps_) {
@@ -158,6 +168,7 @@ void WorldStepper::barrier(std::int64_t tick) {
   for (Endcap& ec : endcaps_) {
     if (ec.expected) ec.first_answer_pending = false;
   }
+  if (expected) nap_.observe((hub_.latest_arrival_ns() > 0 ? hub_.latest_arrival_ns() : monotonic_ns()) - start);
   stats_.max_barrier_wait_s = std::max(stats_.max_barrier_wait_s, ns_to_s(monotonic_ns() - start));
 }
 
@@ -187,6 +198,7 @@ void WorldStepper::apply_due_events() {
 }
 
 void WorldStepper::apply(const ScenarioEvent& ev) {
+  if (ev.fault == FaultKind::cut_dds || ev.fault == FaultKind::restore_dds) return apply_dds_link(ev);
   const int e = ev.endcap;
   Endcap& ec = endcaps_[e];
   const std::int64_t now = now_device_ns();
@@ -212,6 +224,12 @@ void WorldStepper::apply(const ScenarioEvent& ev) {
     case FaultKind::drive_silent:
       for (std::size_t m : motors()) ec.devices.silence_drive(m, true);
       break;
+    case FaultKind::release_spool:
+      for (std::size_t m : motors()) ec.devices.release_spool(m);
+      break;
+    case FaultKind::seize_spool:
+      for (std::size_t m : motors()) ec.devices.seize_spool(m);
+      break;
     case FaultKind::load_cell_stuck: ec.devices.set_load_cell_stuck(true); break;
     case FaultKind::load_cell_drift: ec.devices.start_load_cell_drift(ev.params.n_per_s, now); break;
     case FaultKind::drop_frames:
@@ -224,22 +242,33 @@ void WorldStepper::apply(const ScenarioEvent& ev) {
       break;
     case FaultKind::kill_endcap:
       processes_.kill(e);
+      hub_.forget_version(e);
       ec.state = EndcapState::down;
       ec.devices.on_connection_lost();
       break;
     case FaultKind::restart_endcap:
       if (ec.state == EndcapState::live) processes_.kill(e);
       ec.devices.on_connection_lost();
+      hub_.forget_version(e);
       processes_.restart(e);
       ec.state = EndcapState::waiting_process;
       ec.first_answer_pending = true;
       break;
     case FaultKind::cut_dds:
-    case FaultKind::restore_dds:
-      log_.push_back(ev.describe() + ": not done (needs the DDS link; later)");
-      return;
+    case FaultKind::restore_dds: break;  // apply_dds_link
   }
   log_.push_back(ev.describe());
+}
+
+// endcap -1: every end cap, i.e. the host's own link.
+void WorldStepper::apply_dds_link(const ScenarioEvent& ev) {
+  std::string skipped;
+  for (int e = 0; e < endcap_count(); ++e) {
+    if (ev.endcap >= 0 && e != ev.endcap) continue;
+    const std::string why = processes_.set_dds_link(e, ev.fault == FaultKind::restore_dds);
+    if (!why.empty()) skipped += (skipped.empty() ? "" : "; ") + ("end cap " + std::to_string(e) + ": " + why);
+  }
+  log_.push_back(ev.describe() + (skipped.empty() ? "" : ": not done for " + skipped));
 }
 
 void WorldStepper::update_frame_faults() {
@@ -307,7 +336,9 @@ void WorldStepper::boot() {
 }
 
 void WorldStepper::start() {
-  if (!all_at_gate()) throw HilError("start() before every end cap waits at the start gate");
+  if (!all_at_gate() && !(config_.mode == StepperMode::realtime && config_.realtime_gate_on_arrival)) {
+    throw HilError("start() before every end cap waits at the start gate");
+  }
   for (Endcap& ec : endcaps_) ec.devices.release_gate();
   started_ = true;
   start_centre_ = model_->centre_m();
@@ -350,49 +381,18 @@ void WorldStepper::boot_realtime() {
     }
     hub_.flush();
     if (all_at_gate()) return;
+    if (config_.realtime_gate_on_arrival) {
+      bool all_enabled = true;
+      for (Endcap& ec : endcaps_) {
+        if (ec.state == EndcapState::live && ec.devices.at_gate()) ec.devices.release_gate();
+        all_enabled = all_enabled && ec.state == EndcapState::live && ec.devices.any_follows();
+      }
+      if (all_enabled) return;
+    }
     if (monotonic_ns() - t0 > config_.boot_timeout_ns) throw HilError(boot_report());
   }
 }
 
-void WorldStepper::run_realtime(double duration_s) {
-  const auto steps = static_cast<std::int64_t>(std::llround(duration_s / stats_.dt_s));
-  const std::int64_t t0 = monotonic_ns();
-  std::int64_t next = t0;
-  for (std::int64_t i = 0; i < steps; ++i) {
-    while (monotonic_ns() < next) {
-      rx_.clear();
-      if (hub_.receive(rx_, next) > 0) route(rx_);
-    }
-    if (stop_requested()) throw HilError("interrupted");
-    const std::int64_t lateness = monotonic_ns() - next;
-    if (lateness > period_ns_ / 2) ++stats_.late_steps;
-    stats_.max_lateness_s = std::max(stats_.max_lateness_s, ns_to_s(lateness));
-    // Frames that arrived meanwhile are served before the step.
-    rx_.clear();
-    if (hub_.receive(rx_, 0) > 0) route(rx_);
-    apply_due_events();
-    update_frame_faults();
-    admit_listening();
-    for (int e = 0; e < endcap_count(); ++e) {
-      Endcap& ec = endcaps_[e];
-      if (ec.state != EndcapState::live) continue;
-      // The end cap's bring-up would time out at the gate (2 s of its own clock),
-      // so in real time a rejoining end cap is let through at once: not in phase.
-      if (ec.devices.at_gate()) {
-        ec.devices.release_gate();
-        ++stats_.rejoins;
-        note("end cap " + std::to_string(e) + " enabled again (real time: not phase-aligned)");
-      }
-      ec.devices.tick(now_device_ns(), out_);
-      for (const CanFrame& f : out_) hub_.queue(e, f);
-      out_.clear();
-    }
-    hub_.flush();
-    physics_step();
-    ++ticks_;
-    next += period_ns_;
-  }
-  stats_.run_wall_s = ns_to_s(monotonic_ns() - t0);
-}
+// run_realtime: world_stepper_realtime.cpp
 
 }  // namespace tensegrity::hil

@@ -36,9 +36,12 @@
 #include <vector>
 
 #include "firmware/drivers/spool_geometry.hpp"
+#include "hil/answer_nap.hpp"
 #include "hil/endcap_devices.hpp"
+#include "hil/lateness.hpp"
 #include "hil/recorder.hpp"
 #include "hil/scenario.hpp"
+#include "hil/start_handshake.hpp"
 #include "hil/udp_hub.hpp"
 #include "sim/model.hpp"
 
@@ -54,6 +57,9 @@ class EndcapProcesses {
   virtual std::string describe(int endcap) = 0;
   virtual void kill(int endcap) = 0;
   virtual void restart(int endcap) = 0;
+  // Cuts (up = false) or restores the end cap's DDS link to the host. Returns why
+  // it was not done ("" when done): no DDS link in this run, not running, ...
+  virtual std::string set_dds_link(int endcap, bool up) = 0;
 };
 
 enum class StepperMode : std::uint8_t { lockstep, realtime };
@@ -69,6 +75,19 @@ struct StepperConfig {
   // Rejoin gate: table time 0 only at multiples of this many steps (the policy
   // period), so a restarted end cap plays in phase. 0: release at once.
   std::int64_t phase_period_steps = 0;
+  // Real time, for a provisioner that starts the tables itself (DDS start at a
+  // host time): each end cap's drives are enabled as soon as they ask, and boot
+  // ends when all are. A common gate is then not needed, and in real time it
+  // cannot hold: an end cap waiting at it retries its bring-up after 2 s of its
+  // own clock, so twelve end caps whose programs start seconds apart on a loaded
+  // host (each creating its DDS participant first) never all wait there at once.
+  bool realtime_gate_on_arrival = false;
+  // Real time: the stepper sleeps to this long before each step's deadline and
+  // polls the clock from there (pacer.hpp).
+  std::int64_t spin_ns = 50'000;
+  // Lockstep: sleep this fraction of the end caps' usual answer time before
+  // waiting on the socket (answer_nap.hpp); 0: wait on the socket at once.
+  double answer_nap_fraction = 0.7;
 };
 
 enum class EndcapState : std::uint8_t {
@@ -82,14 +101,18 @@ struct StepperStats {
   std::int64_t steps = 0;  // physics steps
   double boot_wall_s = 0.0;
   double run_wall_s = 0.0;
-  std::int64_t late_steps = 0;     // realtime: started > half a period after the deadline
+  std::int64_t late_steps = 0;     // realtime: began > half a period after its deadline (lateness.hpp)
   double max_lateness_s = 0.0;
+  LatenessSummary lateness;        // realtime: the whole distribution
   double max_barrier_wait_s = 0.0;  // lockstep: longest wait for the end caps' answers
   std::int64_t rejoins = 0;        // gates opened after the start (restart, reset)
   double max_tension_n = 0.0;
   // Lockstep wall-time breakdown of the run phase: sending (sensor PDOs + SYNC),
   // waiting for and serving the end caps' answers, the physics step.
   double send_wall_s = 0.0, barrier_wall_s = 0.0, physics_wall_s = 0.0;
+  // Between the start gate and physics step 0 while a provisioner works (hold()).
+  std::int64_t hold_ticks = 0;
+  double hold_wall_s = 0.0;
   double sim_time_s() const;
   double dt_s = 0.001;
 };
@@ -109,6 +132,16 @@ class WorldStepper {
   void boot();
   // Opens every gate: the next tick is physics step 0 and table time 0.
   void start();
+  // After start(), for a provisioner that talks to the running end caps (DDS):
+  // their buses are served and, in lockstep, SYNCs flow at the wall clock's pace,
+  // physics frozen, until the handshake names physics step 0 (start_handshake.hpp).
+  // Throws HilError on the handshake's failure, an interrupt or `timeout_ns`.
+  void hold(StartHandshake& handshake, std::int64_t timeout_ns);
+  // Real time, after run(): keeps serving the end caps' buses (physics frozen)
+  // until `done()` or `timeout_ns`, so end caps being shut down do not trip their
+  // sensor and drive timeouts in the milliseconds before they exit (their state
+  // at exit is the run's result). Lockstep needs none: without SYNC no time passes.
+  void serve_until(const std::function<bool()>& done, std::int64_t timeout_ns);
   // Physics for duration_s after start(). Throws HilError on a stuck end cap.
   void run(double duration_s);
 
@@ -135,7 +168,8 @@ class WorldStepper {
   void admit_listening();
   void lockstep_tick(bool physics);
   void barrier(std::int64_t tick);
-  void route(const std::vector<UdpHub::Rx>& rx);
+  void route(const std::vector<UdpHub::Rx>& rx);  // serve() and send the answers
+  void serve(const std::vector<UdpHub::Rx>& rx);  // frames to the devices, answers queued
   void physics_step();
   void apply_due_events();
   void apply(const ScenarioEvent& event);
@@ -144,6 +178,11 @@ class WorldStepper {
   std::string boot_report() const;
   void run_realtime(double duration_s);
   void boot_realtime();
+  void hold_lockstep(StartHandshake& handshake, std::int64_t deadline_ns);
+  void hold_realtime(StartHandshake& handshake, std::int64_t deadline_ns);
+  void serve_frames_until(std::int64_t until_ns);
+  void idle_realtime_tick();
+  void apply_dds_link(const ScenarioEvent& event);
   void note(const std::string& line);
 
   const sim::Robot& robot_;
@@ -151,6 +190,7 @@ class WorldStepper {
   UdpHub& hub_;
   EndcapProcesses& processes_;
   StepperConfig config_;
+  AnswerNap nap_{config_.answer_nap_fraction};
   std::int64_t period_ns_;
   std::vector<Endcap> endcaps_;
   Scenario scenario_;

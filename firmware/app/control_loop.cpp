@@ -273,6 +273,9 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
   }
   // In lockstep the HIL produces SYNC; a second producer would double the ticks.
   if (settings_.mode == LoopMode::realtime && master_.send_sync() != CanResult::ok) ++status_.send_failures;
+  // A batching bus sends the cycle's frames (targets, SYNC, SDO, NMT) as one
+  // datagram now: one system call and one wake-up of the other side per cycle.
+  if (bus_.flush() != CanResult::ok) ++status_.send_failures;
 
   ++status_.cycles;
   status_.time_ns = time_ns;

@@ -113,6 +113,8 @@ class ControlLoop {
   const Histogram& wakeup_histogram() const { return wakeup_total_; }
   std::span<const double> commanded_m() const { return {commanded_m_.data(), settings_.core.motor_count}; }
   bool drives_enabled() const;
+  // Realtime: the clock reading at loop time 0 (0 before the first cycle, and in lockstep).
+  std::int64_t clock_origin_ns() const { return origin_ns_; }
 
   // For the other thread (housekeeping): events to log, tables to persist, status.
   bool pop_event(AppEvent& event) { return events_.pop(event); }

@@ -46,6 +46,11 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
+// HIL fault injection (--dds-cut-signals): SIGUSR1 cuts the DDS link, SIGUSR2
+// restores it. A lock-free atomic store is all a handler may do; the node logs it.
+std::atomic<bool> g_link_cut{false};
+extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
+
 int g_id = 0;
 template <typename... Args>
 void log_line(const char* format, Args... args) {
@@ -124,6 +129,8 @@ int main(int argc, char** argv) {
   double duration_s = 0.0;
   bool no_dds = false;
   std::string host_loss = "continue";
+  int domain = -1;
+  bool cut_signals = false;
   cli.add_option("--id", id, "end cap id, 0..11")->required();
   cli.add_option("--config", config_path, "configuration file (tensegrity-endcap/1 JSON)")->required();
   cli.add_option("--policy", policy_path,
@@ -137,8 +144,16 @@ int main(int argc, char** argv) {
   cli.add_option("--host-loss", host_loss, "when the host's heartbeat is lost: continue the gait, or stop")
       ->check(CLI::IsMember({"continue", "stop"}))
       ->capture_default_str();
+  cli.add_option("--domain", domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
+  cli.add_flag("--dds-cut-signals", cut_signals,
+               "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
   CLI11_PARSE(cli, argc, argv);
   g_id = id;
+  // First thing: a SIGUSR1 that arrived before the handler would end the program.
+  if (cut_signals) {
+    std::signal(SIGUSR1, on_link_signal);
+    std::signal(SIGUSR2, on_link_signal);
+  }
 
   app::EndcapAppConfig config;
   core::EndcapTable table;
@@ -191,10 +206,14 @@ int main(int argc, char** argv) {
     try {
       comms::EndcapNodeConfig node_config;
       node_config.endcap_id = id;
-      node_config.domain = msgs::domain_id();
+      node_config.domain = domain >= 0 ? domain : msgs::domain_id();
       node_config.expect.motor_count = config.motor_count;
       node_config.expect.limits = config.limits;
       node_config.host_loss = comms::parse_host_loss_action(host_loss);
+      if (config.mode == app::LoopMode::lockstep) {
+        node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config.period_ns();
+      }
+      if (cut_signals) node_config.link_cut = &g_link_cut;
       node = std::make_unique<comms::EndcapNode>(node_config, clock, storage.get());
       node->start();
       host = node.get();
@@ -206,6 +225,7 @@ int main(int argc, char** argv) {
 #else
   (void)no_dds;
   (void)host_loss;
+  (void)domain;
 #endif
   auto loop = std::make_unique<app::ControlLoop>(*bus.bus, clock, *host, app::make_loop_settings(config));
   if (have_table && loop->load_table(table) != core::TableError::none) {
@@ -272,7 +292,20 @@ int main(int argc, char** argv) {
            static_cast<unsigned long long>(s.late_wakeups), us(cycle.p50_ns), us(cycle.p99_ns), us(cycle.max_ns),
            us(wake.p50_ns), us(wake.p99_ns), rss_kb);
   if (!stats_path.empty()) {
+    // Where the table stood at the last cycle, so a launcher can check that end caps
+    // play in phase: table time at the last loop time and, in real time, the
+    // CLOCK_MONOTONIC reading of loop time 0 (table time 0 = that + origin_loop_ns).
+    nlohmann::json table_state = nullptr;
+    const core::EndcapController& ctl = loop->controller();
+    if (ctl.mode() == core::Mode::running) {
+      table_state = {{"period_s", ctl.active_table().period_s},
+               {"loop_time_ns", s.time_ns},
+               {"table_time_ns", ctl.table_time_ns(s.time_ns)},
+               {"origin_loop_ns", s.time_ns - ctl.table_time_ns(s.time_ns)}};
+      if (config.mode == app::LoopMode::realtime) table_state["loop_clock_origin_ns"] = loop->clock_origin_ns();
+    }
     const nlohmann::json stats = {
+        {"table", table_state},
         {"endcap", id},
         {"mode", to_string(config.mode)},
         {"rate_hz", config.loop_rate_hz},

@@ -94,6 +94,7 @@ void validate(const EndcapNodeConfig& c) {
   positive(c.host_timeout_s, "host_timeout_s", 3600.0);
   positive(c.loop_ack_timeout_s, "loop_ack_timeout_s", 60.0);
   positive(c.command_max_age_s, "command_max_age_s", 3600.0);
+  if (c.start_grid_ns < 0) throw std::invalid_argument("start_grid_ns = " + std::to_string(c.start_grid_ns) + ": expected >= 0");
 }
 
 struct EndcapNode::Dds {
@@ -110,8 +111,23 @@ struct EndcapNode::Dds {
   dds::DataReader* host_heartbeat = nullptr;
   dds::DataReader* sync_reply = nullptr;
   std::vector<std::unique_ptr<CallbackListener>> listeners;
+  // The time-sync listener runs on Fast DDS's receive thread and uses this object,
+  // from the moment its reader exists until the participant is gone: close() lets
+  // a callback in progress finish (it holds the mutex), then refuses later ones,
+  // and only then deletes anything. Without it, a reply arriving while the node
+  // stopped reached through a half-destroyed object (seen: SIGSEGV at exit).
+  std::mutex callback_mutex;
+  bool closed = false;  // guarded by callback_mutex
 
-  ~Dds() { msgs::delete_participant(participant); }
+  ~Dds() { close(); }
+  void close() noexcept {
+    {
+      std::lock_guard lock(callback_mutex);
+      closed = true;
+    }
+    msgs::delete_participant(participant);
+    participant = nullptr;
+  }
 
   dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
     return msgs::create_writer(*participant, *publisher, spec, type);
@@ -133,7 +149,7 @@ EndcapNode::~EndcapNode() { stop(); }
 void EndcapNode::start() {
   if (running_.load()) return;
   auto d = std::make_unique<Dds>();
-  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id));
+  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), config_.link_cut);
   d->publisher = d->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   d->subscriber = d->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (d->publisher == nullptr || d->subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
@@ -147,12 +163,19 @@ void EndcapNode::start() {
     raw->listeners.push_back(std::make_unique<CallbackListener>(std::move(fn), topic, config_.endcap_id, config_.log));
     return raw->listeners.back().get();
   };
-  // Readers last: a callback may fire as soon as a reader exists, and it may use
-  // the writers.
-  d->sync_reply = d->reader(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new m::TimeSyncReply_PubSubType()),
-                            listener([this] { on_time_sync_reply(); }, msgs::kTimeSyncReplyTopic.name));
+  // Readers last: a callback may fire as soon as a reader exists (replies to other
+  // end caps are on the same topic), and it may use the writers. It reaches the
+  // reader through `raw` under its mutex, never through dds_ (not yet set here).
+  dds::DataReader* sync_reply =
+      d->reader(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new m::TimeSyncReply_PubSubType()),
+                listener([this, raw] { on_time_sync_reply(*raw); }, msgs::kTimeSyncReplyTopic.name));
+  {
+    std::lock_guard lock(d->callback_mutex);
+    d->sync_reply = sync_reply;
+  }
   dds_ = std::move(d);
   const std::int64_t now = clock_.now_ns();
+  started_ns_ = now;
   next_telemetry_ns_ = now;
   next_heartbeat_ns_ = now;
   next_sync_ns_ = now;
@@ -172,6 +195,8 @@ void EndcapNode::stop() noexcept {
     wake();
     if (thread_.joinable()) thread_.join();
   }
+  // Entities deleted while dds_ still points at them (reset() would null it first).
+  if (dds_) dds_->close();
   dds_.reset();
 }
 
@@ -219,6 +244,7 @@ void EndcapNode::run() {
 }
 
 void EndcapNode::service(std::int64_t now) {
+  report_link_cut();
   StampedTelemetry t;
   if (telemetry_in_.read(t)) {
     last_telemetry_ = t;
@@ -383,6 +409,15 @@ void EndcapNode::handle_commands(std::int64_t now) {
                      static_cast<double>(now + sample.offset_ns - cmd.issued_host_time_ns()) / 1e9);
       }
       continue;
+    } else if (synced && cmd.issued_host_time_ns() < started_ns_ + sample.offset_ns) {
+      // Issued before this program started: an order to its previous life, kept in
+      // the writer's history (transient local). A restarted end cap acting on it
+      // would restart a table it already plays (start on boot) at another phase.
+      if (config_.log) {
+        std::fprintf(stderr, "endcap %d: ignored command %u issued before this end cap started (history)\n",
+                     config_.endcap_id, cmd.seq());
+      }
+      continue;
     } else if (cmd.kind() > 3) {
       reason = CommandReason::unknown_kind;
     } else {
@@ -396,7 +431,15 @@ void EndcapNode::handle_commands(std::int64_t now) {
           // host -> node clock -> loop clock (loop time advanced with the node's
           // clock since the loop's last publish).
           const std::int64_t local = cmd.start_host_time_ns() - sample.offset_ns;
-          out.start_time_ns = local - last_telemetry_.local_ns + last_telemetry_.telemetry.time_ns;
+          const std::int64_t since_last_cycle = local - last_telemetry_.local_ns;
+          out.start_time_ns = last_telemetry_.telemetry.time_ns + since_last_cycle;
+          if (config_.start_grid_ns > 0) {
+            // Lockstep: whole grid steps after the last cycle (see the config).
+            const std::int64_t g = config_.start_grid_ns;
+            const std::int64_t steps = since_last_cycle >= 0 ? (since_last_cycle + g / 2) / g
+                                                             : -((-since_last_cycle + g / 2) / g);
+            out.start_time_ns = last_telemetry_.telemetry.time_ns + steps * g;
+          }
         }
       }
       if (reason == CommandReason::accepted && !commands_.push(out)) reason = CommandReason::mailbox_full;
@@ -436,6 +479,18 @@ void EndcapNode::handle_host_heartbeats(std::int64_t now) {
     }
     last_host_heartbeat_ns_ = now;
     host_seen_ = true;
+  }
+}
+
+// The flag is flipped from outside (a signal handler): said here, on the node's
+// thread, so the log shows when the link went and came back.
+void EndcapNode::report_link_cut() {
+  if (config_.link_cut == nullptr) return;
+  const bool cut = config_.link_cut->load(std::memory_order_relaxed);
+  if (cut == link_was_cut_) return;
+  link_was_cut_ = cut;
+  if (config_.log) {
+    std::fprintf(stderr, "endcap %d: DDS link %s (fault injection)\n", config_.endcap_id, cut ? "CUT" : "restored");
   }
 }
 
@@ -526,10 +581,12 @@ void EndcapNode::send_time_sync_request(std::int64_t) {
   dds_->sync_request->write(&req);
 }
 
-void EndcapNode::on_time_sync_reply() {
+void EndcapNode::on_time_sync_reply(Dds& d) {
+  std::lock_guard guard(d.callback_mutex);
+  if (d.closed || d.sync_reply == nullptr) return;  // stopping, or still starting (taken next time)
   m::TimeSyncReply_ reply;
   dds::SampleInfo info;
-  while (dds_->sync_reply->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+  while (d.sync_reply->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
     const std::int64_t t4 = clock_.now_ns();  // stamped before anything else
     if (!info.valid_data || reply.endcap_id() != config_.endcap_id) continue;
     if (reply.format_version() != msgs::kFormatVersion) continue;

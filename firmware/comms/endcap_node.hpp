@@ -30,6 +30,11 @@
 
 namespace tensegrity::fw::comms {
 
+// The lockstep start grid in loop periods (start_grid_ns = this x the period):
+// 200 ms at 1 kHz. A 50 ms grid failed (tables 1-2 ticks apart) when the 2-core
+// host ran other real-time work at load 30 and time-sync errors exceeded 25 ms.
+inline constexpr std::int64_t kLockstepStartGridPeriods = 200;
+
 enum class HostLossAction : std::uint8_t { continue_gait = 0, stop = 1 };
 const char* to_string(HostLossAction action);
 // "continue" | "stop"; throws std::invalid_argument naming the accepted values.
@@ -50,6 +55,18 @@ struct EndcapNodeConfig {
   // history, not an order: ignored.
   double command_max_age_s = 5.0;
   bool log = true;  // one line per event to stderr
+  // Lockstep (loop time = SYNC count x period, kept by whoever sends SYNC): host
+  // time maps to loop time only while the SYNCs pause, so a start is placed a
+  // whole number of these grid steps after the loop's last cycle: the host time
+  // since that cycle, rounded. A HIL that pauses its SYNCs and aims the start at a
+  // whole number of grid steps after the last one gets every end cap on the same
+  // SYNC with table time exactly 0, as long as each end cap's mapping error (time
+  // sync, wake-up latency: milliseconds on a loaded host) stays under half a
+  // step. 0: no grid (a free-running loop maps host time directly).
+  std::int64_t start_grid_ns = 0;
+  // Fault injection (HIL): while *link_cut is true the participant's transport
+  // drops every datagram in and out (msgs/link_cut_transport.hpp). Null: never cut.
+  const std::atomic<bool>* link_cut = nullptr;
 };
 
 // Checks rates and timeouts; throws std::invalid_argument naming the field.
@@ -101,7 +118,7 @@ class EndcapNode final : public app::HostLink {
   void send_telemetry(std::int64_t now_ns);
   void send_heartbeat(std::int64_t now_ns);
   void send_time_sync_request(std::int64_t now_ns);
-  void on_time_sync_reply();  // DDS listener thread
+  void on_time_sync_reply(Dds& dds);  // DDS listener thread
   void send_policy_ack(const PolicyTableMsg& msg, PolicyReason reason, const std::string& text);
   void load_persisted_identity();
   void persist_identity();
@@ -146,6 +163,9 @@ class EndcapNode final : public app::HostLink {
   std::int64_t next_heartbeat_ns_ = 0;
   std::int64_t next_sync_ns_ = 0;
   std::uint64_t refused_format_ = 0;
+  bool link_was_cut_ = false;
+  std::int64_t started_ns_ = 0;  // node clock at start(): older commands are history
+  void report_link_cut();
 
   mutable std::mutex mutex_;  // guards active_, sync_ (listener thread vs node thread)
   ActivePolicy active_;

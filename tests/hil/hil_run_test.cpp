@@ -1,16 +1,22 @@
 // SPDX-License-Identifier: Apache-2.0
 // The HIL with twelve real `endcap` programs: fidelity against the in-process
-// reference, the barrier naming a missing or stopped end cap, a drive fault,
-// corrupted frames, and a killed end cap that restarts and rejoins in phase.
+// reference with either provisioner, the barrier naming a missing or stopped end
+// cap, a drive fault, corrupted frames, real-time pacing. Restarts:
+// hil_rejoin_test.cpp; the DDS link: hil_dds_test.cpp.
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <thread>
+#include <set>
+#include <string>
 
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
+#include "tests/hil/hil_test_support.hpp"
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
 #include "sim/policy.hpp"
@@ -20,74 +26,65 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const sim::Robot& robot() {
-  static const sim::Robot r = sim::load_robot(sim::default_robot_path());
-  return r;
-}
-
-// The hand-made development policy of tools/make_dev_policy.py.
-const fs::path& policy_file() {
-  static const fs::path path = [] {
-    sim::Policy p;
-    p.robot = robot().name;
-    p.period_s = 4.0;
-    p.complexity = 5;
-    p.provenance.method = "hand";
-    for (int m = 0; m < robot().cable_count(); ++m) {
-      sim::CablePolicy c{m, robot().cables[m].owner, {}};
-      for (int j = 0; j < 5; ++j) c.rest_lengths_m.push_back(0.85 + 0.15 * std::sin(2 * M_PI * j / 5 + 2 * M_PI * m / 24));
-      p.cables.push_back(c);
-    }
-    const fs::path f = fs::temp_directory_path() / ("hil_test_policy_" + std::to_string(::getpid()) + ".json");
-    sim::save_policy(f, p);
-    return f;
-  }();
-  return path;
-}
-
-// A policy from a short coevolution run on this robot (7.1 m in 60 s): it rolls,
-// so a timing or phase error shows in the distance.
-fs::path evolved_policy_file() {
-  return fs::path(std::getenv("TENSEGRITY_SOURCE_DIR")) / "tests/hil/data/evolved-t4-n5.json";
-}
-
-HilOptions options(double duration_s) {
-  HilOptions o;
-  o.policy = policy_file();
-  o.duration_s = duration_s;
-  o.barrier_timeout_s = 2.0;
-  o.boot_timeout_s = 20.0;
-  return o;
-}
+using namespace hil_test;
 
 const EndcapSummary& endcap(const HilResult& r, int e) { return r.endcaps.at(e); }
 
-TEST(HilRun, LockstepMatchesInProcessWithinTwoPercent) {
+// Both provisioners must start all twelve tables on physics step 0 with table time
+// 0: then the HIL computes exactly what the in-process simulation does.
+class HilFidelity : public ::testing::TestWithParam<Provision> {};
+
+TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
   const double duration_s = 10.0;
   sim::CoreController reference(robot(), sim::load_policy(evolved_policy_file(), robot()));
   sim::EpisodeOptions eo;
   eo.duration_s = duration_s;
   const sim::EpisodeResult ref = sim::run_episode(robot(), reference, eo);
 
-  HilOptions o = options(duration_s);
+  const std::set<std::string> shm_before = dds_shm_files();
+  HilOptions o = options(duration_s, GetParam());
   o.policy = evolved_policy_file();
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_EQ(r.stats.steps, 10'000);
-  std::printf("fidelity: HIL %.4f m, in-process %.4f m\n", r.distance_m, ref.distance_m);
   ASSERT_GT(ref.distance_m, 0.5) << "the policy should move the robot";
   EXPECT_NEAR(r.distance_m, ref.distance_m, 0.02 * ref.distance_m)
       << "HIL " << r.distance_m << " m vs in-process " << ref.distance_m << " m";
+  // Stronger than the 2 %: what is left is the drives' position quantisation
+  // (0.14 um per count: ~1e-7 relative); one table a tick off showed as ~1e-3.
+  EXPECT_NEAR(r.distance_m, ref.distance_m, 1e-5 * ref.distance_m) << "a table started off physics step 0";
+  EXPECT_EQ(r.playing, 12);
+  EXPECT_EQ(r.max_phase_offset_s, 0.0) << "every table at the same table time at the last SYNC";
   for (const auto& e : r.endcaps) {
+    EXPECT_EQ(e.phase_offset_s, 0.0) << "end cap " << e.endcap << " table phase off";
     EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
     // Every physics step was one cycle of every end cap (plus its boot cycles).
     EXPECT_GE(e.cycles, 10'000u) << "end cap " << e.endcap;
     EXPECT_EQ(e.exit_status, 0) << "end cap " << e.endcap << " did not shut down cleanly";
+    // Not asserted: at full lockstep speed the emulator and the loops (real-time
+    // priority) can starve the DDS threads on a loaded 2-core host long enough for
+    // an end cap to call its host lost (docs/hil.md); the gait is open loop.
+    if (e.host_losses > 0) std::printf("end cap %d reported %d host loss(es)\n", e.endcap, e.host_losses);
   }
-  std::printf("fidelity: HIL %.4f m, in-process %.4f m (%+.3f%%), %.1fx real time (send %.2f s, barrier %.2f s, physics %.2f s)\n",
-              r.distance_m, ref.distance_m, 100.0 * (r.distance_m - ref.distance_m) / ref.distance_m,
-              r.stats.sim_time_s() / r.stats.run_wall_s, r.stats.send_wall_s, r.stats.barrier_wall_s, r.stats.physics_wall_s);
+  EXPECT_TRUE(child_pids().empty()) << "end-cap processes left behind";
+  EXPECT_EQ(dds_shm_files(), shm_before) << "shared-memory files left in /dev/shm";
+  for (const auto& line : r.log) {
+    if (line.rfind("dds:", 0) == 0) std::printf("%s\n", line.c_str());
+  }
+  std::printf("fidelity (%s): HIL %.6f m, in-process %.6f m (%+.5f%%), %.1fx real time (send %.2f s, barrier %.2f s, "
+              "physics %.2f s), hold %.3f s\n",
+              to_string(GetParam()), r.distance_m, ref.distance_m,
+              100.0 * (r.distance_m - ref.distance_m) / ref.distance_m, r.stats.sim_time_s() / r.stats.run_wall_s,
+              r.stats.send_wall_s, r.stats.barrier_wall_s, r.stats.physics_wall_s, r.stats.hold_wall_s);
 }
+
+#ifdef TENSEGRITY_HIL_DDS
+#define HIL_PROVISIONERS Provision::local, Provision::dds
+#else
+#define HIL_PROVISIONERS Provision::local
+#endif
+INSTANTIATE_TEST_SUITE_P(Provisioners, HilFidelity, ::testing::Values(HIL_PROVISIONERS),
+                         [](const ::testing::TestParamInfo<Provision>& i) { return std::string(to_string(i.param)); });
 
 TEST(HilRun, BootNamesAnEndCapThatNeverStarted) {
   HilOptions o = options(1.0);
@@ -107,17 +104,27 @@ TEST(HilRun, BarrierTimeoutNamesAStoppedEndCap) {
     if (!stopped && s.step_index() == 500) {
       ::kill(l.pid(9), SIGSTOP);
       stopped = true;
+      // A stop takes effect when every thread of the program has seen it, which
+      // can take several ticks of a fast lockstep run: wait for it here, so the
+      // next SYNC is the first one the end cap cannot answer.
+      for (int i = 0; i < 1000 && l.describe(9).find("stopped") == std::string::npos; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
     }
   };
   const HilResult r = run_hil(o);
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.error.find("end cap 9 sent no RPDO1 for drive node(s) 1, 3"), std::string::npos) << r.error;
   EXPECT_NE(r.error.find("stopped"), std::string::npos) << r.error;
-  // SIGSTOP races the SYNC the stepper sends right after step 500: the end cap may
-  // or may not have answered it before it stopped.
-  EXPECT_TRUE(r.error.find("physics step 500") != std::string::npos ||
-              r.error.find("physics step 501") != std::string::npos)
-      << r.error;
+  // SIGSTOP races the SYNCs the stepper sends after step 500: a process stops once
+  // each of its threads next enters the kernel (more threads with DDS), and the
+  // stepper runs a tick in well under a millisecond, so the end cap may answer a
+  // few dozen more before it stops.
+  const auto at = r.error.find("(physics step ");
+  ASSERT_NE(at, std::string::npos) << r.error;
+  const long step = std::stol(r.error.substr(at + std::string("(physics step ").size()));
+  EXPECT_GE(step, 500) << r.error;
+  EXPECT_LT(step, 700) << r.error;
 }
 
 TEST(HilRun, DriveFaultPutsTheEndCapInSafeStateAndIsReported) {
@@ -140,8 +147,9 @@ TEST(HilRun, DriveFaultPutsTheEndCapInSafeStateAndIsReported) {
       EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
     }
   }
-  ASSERT_FALSE(r.log.empty());
-  EXPECT_NE(r.log[0].find("end cap 3: drive_fault"), std::string::npos);
+  bool logged = false;
+  for (const auto& line : r.log) logged = logged || line.find("end cap 3: drive_fault") != std::string::npos;
+  EXPECT_TRUE(logged) << ::testing::PrintToString(r.log);
 }
 
 TEST(HilRun, CorruptedFramesAreCountedAndIgnored) {
@@ -163,30 +171,6 @@ TEST(HilRun, CorruptedFramesAreCountedAndIgnored) {
   EXPECT_EQ(endcap(r, 4).bus.injected_corrupt, 0u);
 }
 
-TEST(HilRun, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
-  HilOptions o = options(10.0);
-  ScenarioEvent kill;
-  kill.time_s = 1.0;
-  kill.endcap = 4;
-  kill.fault = FaultKind::kill_endcap;
-  ScenarioEvent restart = kill;
-  restart.time_s = 1.5;
-  restart.fault = FaultKind::restart_endcap;
-  o.scenario.events = {kill, restart};
-  const HilResult r = run_hil(o);
-  ASSERT_TRUE(r.ok) << r.error;
-  EXPECT_EQ(endcap(r, 4).restarts, 1u);
-  EXPECT_EQ(r.stats.rejoins, 1);
-  EXPECT_EQ(endcap(r, 4).fault, "none");
-  bool rejoined_in_phase = false;
-  for (const auto& line : r.log) {
-    // The policy period is 4 s = 4000 steps: the gate opens at a multiple of it.
-    if (line.find("end cap 4 enabled again (table time 0 at step 4000)") != std::string::npos) rejoined_in_phase = true;
-  }
-  EXPECT_TRUE(rejoined_in_phase) << ::testing::PrintToString(r.log);
-  EXPECT_EQ(endcap(r, 4).devices.drive_states[0], "operation enabled");
-}
-
 TEST(HilRun, RealTimeModePacesToTheWallClock) {
   HilOptions o = options(3.0);
   o.mode = StepperMode::realtime;
@@ -194,12 +178,11 @@ TEST(HilRun, RealTimeModePacesToTheWallClock) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_EQ(r.stats.steps, 3000);
   EXPECT_NEAR(r.stats.run_wall_s, 3.0, 0.3);
-  // Known issue (open): on this loaded 2-core machine an end cap sometimes trips
-  // "load cell timeout" (20 ms without a fresh sample) in real time; reported, not
-  // asserted, until it is understood.
-  for (const auto& e : r.endcaps) {
-    if (e.fault != "none") std::printf("real time: end cap %d fault: %s\n", e.endcap, e.fault.c_str());
-  }
+  // Its own clock keeps running after the last step: the emulator serves the
+  // buses until the programs have exited, so none trips a sensor timeout (a
+  // "load cell timeout" at exit was seen before it did).
+  for (const auto& e : r.endcaps) EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
+  EXPECT_EQ(r.playing, 12);
   std::printf("real time: %lld late steps of %lld, worst %.3f ms\n", static_cast<long long>(r.stats.late_steps),
               static_cast<long long>(r.stats.steps), r.stats.max_lateness_s * 1e3);
 }

@@ -22,6 +22,8 @@ TEST(HilScenario, ParsesSortsAndDefaults) {
   EXPECT_EQ(s.events[1].params.corrupt_kind, CorruptKind::datagram);
   EXPECT_EQ(s.events[2].fault, FaultKind::kill_endcap);
   EXPECT_EQ(s.events[3].fault, FaultKind::cut_dds);
+  EXPECT_EQ(s.events[3].endcap, -1) << "no endcap: every end cap's link";
+  EXPECT_NE(s.events[3].describe().find("all end caps: cut_dds"), std::string::npos);
 }
 
 TEST(HilScenario, ErrorsNameTheField) {
@@ -46,6 +48,28 @@ TEST(HilScenario, FaultOption) {
   EXPECT_EQ(e.fault, FaultKind::drive_silent);
   EXPECT_DOUBLE_EQ(e.time_s, 2.5);
   EXPECT_THROW(parse_fault_option("3-drive_silent", 12), HilError);
+  EXPECT_EQ(parse_fault_option("all:cut_dds@5", 12).endcap, -1);
+  EXPECT_EQ(parse_fault_option("4:restore_dds@6.5", 12).endcap, 4);
+  EXPECT_THROW(parse_fault_option("all:kill_endcap@5", 12), HilError);  // "all" only for the link
+  EXPECT_THROW(parse_fault_option("3:kill_endcap@5x", 12), HilError);
+}
+
+TEST(HilScenario, DisabledCableFaultsItsOwnersDriveAndReleasesIt) {
+  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  // Cable 3 (nodes 0-10) is owned by end cap 10, whose cables are 3 and 16.
+  const ScenarioEvent e = disabled_cable_event(robot, 3);
+  EXPECT_EQ(e.endcap, 10);
+  EXPECT_EQ(e.fault, FaultKind::drive_fault);
+  EXPECT_EQ(robot.cables_of(10).at(static_cast<std::size_t>(e.params.motor)), 3);
+  EXPECT_TRUE(e.params.release);
+  EXPECT_DOUBLE_EQ(e.time_s, 0.0);
+  EXPECT_THROW(disabled_cable_event(robot, 24), HilError);
+  // Only the spool: the drive does not fault, the end cap keeps its other cable.
+  const ScenarioEvent spool = disabled_cable_event(robot, 3, CableFailure::spool);
+  EXPECT_EQ(spool.fault, FaultKind::release_spool);
+  EXPECT_EQ(spool.params.motor, e.params.motor);
+  EXPECT_EQ(parse_fault_option("10:release_spool@0", 12).fault, FaultKind::release_spool);
+  EXPECT_EQ(disabled_cable_event(robot, 3, CableFailure::seize).fault, FaultKind::seize_spool);
 }
 
 }  // namespace

@@ -1,0 +1,339 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "hil/dds_provisioner.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <limits>
+
+#include "ground/command.hpp"
+#include "ground/station.hpp"
+#include "ground/status.hpp"
+#include "ground/upload.hpp"
+#include "hil/hil_error.hpp"
+
+namespace tensegrity::hil {
+
+namespace {
+
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+constexpr std::int64_t kTickNs = 1'000'000;  // the end caps' loop period in the HIL (1 kHz)
+constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
+
+std::int64_t to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+
+// Threads of this provisioner talk DDS; they must not inherit the emulator's
+// SCHED_FIFO (they would compete with the stepper they wait for).
+void normal_priority() {
+  sched_param p{};
+  pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
+}
+
+std::string list(const std::vector<int>& ids) {
+  std::string s;
+  for (int i : ids) s += (s.empty() ? "" : ", ") + std::to_string(i);
+  return s;
+}
+
+}  // namespace
+
+DdsProvisioner::DdsProvisioner(const sim::Robot& robot, const sim::Policy& policy,
+                               const std::filesystem::path& policy_file, const DdsProvisionerConfig& config)
+    : robot_(robot),
+      policy_(policy),
+      policy_id_(policy_file.stem().string().substr(0, 64)),
+      config_(config),
+      lease_(config.domain),
+      restarted_at_ns_(static_cast<std::size_t>(robot.endcap_count()), 0) {
+  if (robot.endcap_count() > ground::kEndcapCount) {
+    throw HilError("the DDS link addresses at most " + std::to_string(ground::kEndcapCount) + " end caps");
+  }
+  if (config_.host_loss != "continue" && config_.host_loss != "stop") {
+    throw HilError("host loss '" + config_.host_loss + "': expected continue or stop");
+  }
+  if (policy_id_.empty()) policy_id_ = "policy";
+  ground::StationOptions so;
+  so.domain = lease_.domain();
+  so.name = "tensegrity-hil";
+  station_ = std::make_unique<ground::Station>(so);
+}
+
+DdsProvisioner::~DdsProvisioner() { end_run(); }
+
+std::string DdsProvisioner::name() const {
+  return "dds (domain " + std::to_string(lease_.domain()) + ", upload + start command)";
+}
+
+std::vector<std::string> DdsProvisioner::endcap_arguments(int, bool restart) const {
+  std::vector<std::string> args{"--domain", std::to_string(lease_.domain()), "--dds-cut-signals", "--host-loss",
+                                config_.host_loss};
+  // Lockstep: the stepper's gate lets a restarted end cap through on a period
+  // boundary, and start on boot makes that tick table time 0 (see the header).
+  if (restart && config_.mode == StepperMode::lockstep) args.emplace_back("--start-on-boot");
+  return args;
+}
+
+void DdsProvisioner::note(const std::string& line) {
+  std::lock_guard lock(mutex_);
+  log_.push_back(line);
+}
+
+std::vector<std::string> DdsProvisioner::log() const {
+  std::lock_guard lock(mutex_);
+  return log_;
+}
+
+void DdsProvisioner::deliver(StartHandshake& handshake) {
+  normal_priority();
+  const int n = robot_.endcap_count();
+  const auto mask = static_cast<std::uint16_t>((1U << n) - 1U);
+  const std::int64_t t0 = ground::Station::now_ns();
+
+  // 1. Everyone on the link with a synchronized clock (a start needs one).
+  if (!station_->wait_for_endcaps(mask, true, t0 + to_ns(config_.discovery_timeout_s))) {
+    std::vector<int> missing, unsynced;
+    const auto status = station_->snapshot();
+    for (int e = 0; e < n; ++e) {
+      if (!status[e].seen) {
+        missing.push_back(e);
+      } else if (!status[e].heartbeat.clock_synced()) {
+        unsynced.push_back(e);
+      }
+    }
+    char within[64];
+    std::snprintf(within, sizeof within, "DDS: within %.1f s", config_.discovery_timeout_s);
+    std::string why = within;
+    if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
+    if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
+    throw HilError(why + " (see their logs)");
+  }
+  const std::int64_t t_found = ground::Station::now_ns();
+
+  // 2. The policy, as `tensegrity upload` sends it.
+  fw::comms::PolicyIdentity identity;
+  identity.policy_id = policy_id_;
+  identity.policy_version = static_cast<std::uint32_t>(std::time(nullptr));
+  identity.robot = robot_.name;
+  const auto tables = ground::policy_messages(policy_, robot_, identity, ground::random_sequence_base());
+  ground::UploadOptions uo;
+  uo.timeout_s = config_.upload_timeout_s;
+  const ground::UploadReport upload = ground::upload(*station_, tables, uo);
+  if (!upload.all_accepted()) {
+    std::string why;
+    for (const auto& r : upload.results) {
+      if (r.accepted) continue;
+      why += (why.empty() ? "" : "; ") + ("end cap " + std::to_string(r.endcap) + ": " +
+                                          (r.acked ? "rejected (" + r.text + ")" : std::string("no acknowledgement")));
+    }
+    throw HilError("policy upload over DDS incomplete: " + why);
+  }
+  double worst_ms = 0.0;
+  for (const auto& r : upload.results) worst_ms = std::max(worst_ms, r.latency_s * 1e3);
+
+  // Real time: an end cap armed early in the boot may have latched a sensor
+  // timeout while the emulator was busy starting the others. Cleared, and said.
+  if (!clear_faults_before_start(mask, ground::Station::now_ns() + to_ns(config_.command_timeout_s))) {
+    std::string why;
+    const auto status = station_->snapshot();
+    for (int e = 0; e < n; ++e) {
+      if (status[e].heartbeat.fault() != 0) {
+        why += (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
+      }
+    }
+    throw HilError("end cap(s) " + why + " still faulted after a clear-fault before the start");
+  }
+
+  // 3. One start time for all, once every clock is known well enough to place it.
+  const double settle_rt_ms =
+      settle_time_sync(mask, ground::Station::now_ns() + to_ns(config_.sync_settle_timeout_s)) * 1e3;
+  ground::CommandOptions co;
+  co.endcap_mask = mask;
+  co.timeout_s = config_.command_timeout_s;
+  std::int64_t start_ns = 0;
+  std::string how;
+  if (config_.mode == StepperMode::lockstep) {
+    const FrozenTick frozen = handshake.freeze(ground::Station::now_ns() + 10 * kNsPerS);
+    // k ticks after the last SYNC (plus half the window in which the end caps ran
+    // it): each end cap rounds the host time since its last cycle to its start grid,
+    // so its mapping error (time sync, wake-up) may be up to half a grid step.
+    start_ns = frozen.sent_ns + config_.start_after_ticks * kTickNs + (frozen.answered_ns - frozen.sent_ns) / 2;
+    how = "SYNC +" + std::to_string(config_.start_after_ticks) + " after the freeze (last tick answered in " +
+          std::to_string((frozen.answered_ns - frozen.sent_ns) / 1000) + " us)";
+  } else {
+    start_ns = ground::Station::now_ns() + to_ns(config_.realtime_lead_s);
+    char in[48];
+    std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);
+    how = in;
+  }
+  const ground::CommandReport report = ground::send_command(*station_, ground::CommandKind::start, start_ns, co);
+  if (!report.all_accepted()) {
+    std::string why;
+    for (const auto& r : report.results) {
+      if (!r.accepted) why += (why.empty() ? "" : "; ") + ("end cap " + std::to_string(r.endcap) + ": " + r.text);
+    }
+    throw HilError("start command over DDS not accepted: " + why);
+  }
+  if (config_.mode == StepperMode::realtime && ground::Station::now_ns() >= start_ns) {
+    throw HilError("start command acknowledged only after its start time (the link was too slow)");
+  }
+  start_host_ns_ = start_ns;
+  // The time sync's quality: every process here reads the same clock, so each
+  // end cap's offset estimate is its error.
+  double worst_offset_ms = 0.0, worst_round_trip_ms = 0.0;
+  for (const auto& s : station_->snapshot()) {
+    if (!s.seen) continue;
+    worst_offset_ms = std::max(worst_offset_ms, std::abs(static_cast<double>(s.heartbeat.clock_offset_ns())) * 1e-6);
+    worst_round_trip_ms = std::max(worst_round_trip_ms, static_cast<double>(s.heartbeat.clock_round_trip_ns()) * 1e-6);
+  }
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "dds: %d end caps on domain %d in %.0f ms; policy %s v%u uploaded in %.1f ms (slowest ack %.1f ms); "
+                "start at host time %.6f s (%s); time sync at the start: worst round trip %.3f ms; at the end of "
+                "the hold: worst offset %.3f ms, worst round trip %.3f ms",
+                n, lease_.domain(), static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(),
+                identity.policy_version, upload.total_s * 1e3, worst_ms, static_cast<double>(start_ns) * 1e-9,
+                how.c_str(), settle_rt_ms, worst_offset_ms, worst_round_trip_ms);
+  note(line);
+  if (config_.mode == StepperMode::lockstep) {
+    handshake.go_after_ticks(config_.start_after_ticks);
+  } else {
+    handshake.go_at(start_ns);
+  }
+}
+
+bool DdsProvisioner::clear_faults_before_start(std::uint16_t mask, std::int64_t deadline_ns) {
+  std::uint16_t faulted = 0;
+  std::string which;
+  for (int e = 0; e < ground::kEndcapCount; ++e) {
+    const ground::EndcapStatus s = station_->snapshot()[e];
+    if ((mask & (1U << e)) == 0 || !s.seen || s.heartbeat.fault() == 0) continue;
+    faulted = static_cast<std::uint16_t>(faulted | (1U << e));
+    which += (which.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(s.heartbeat.fault()) + ")";
+  }
+  if (faulted == 0) return true;
+  ground::CommandOptions co;
+  co.endcap_mask = faulted;
+  co.timeout_s = config_.command_timeout_s;
+  ground::send_command(*station_, ground::CommandKind::clear_fault, 0, co);
+  note("dds: end cap(s) " + which + " had latched a fault before the start: cleared (clear-fault)");
+  // The heartbeat (5 Hz) says when it took; the drives may take a few cycles more.
+  for (;;) {
+    bool clear = true;
+    const auto status = station_->snapshot();
+    for (int e = 0; e < ground::kEndcapCount; ++e) {
+      if ((faulted & (1U << e)) == 0) continue;
+      clear = clear && status[e].heartbeat.fault() == 0 && status[e].have_telemetry &&
+              status[e].telemetry.fault() == 0 && status[e].telemetry.drives_enabled();
+    }
+    if (clear) return true;
+    if (ground::Station::now_ns() >= deadline_ns) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+double DdsProvisioner::settle_time_sync(std::uint16_t mask, std::int64_t deadline_ns) const {
+  const auto limit_ns = static_cast<std::int64_t>(config_.max_sync_round_trip_s * 1e9);
+  for (;;) {
+    std::int64_t worst = 0;
+    for (int e = 0; e < ground::kEndcapCount; ++e) {
+      if ((mask & (1U << e)) == 0) continue;
+      const ground::EndcapStatus s = station_->snapshot()[e];
+      worst = std::max(worst, s.seen && s.heartbeat.clock_synced() ? s.heartbeat.clock_round_trip_ns()
+                                                                     : std::numeric_limits<std::int64_t>::max());
+    }
+    if (worst <= limit_ns || ground::Station::now_ns() >= deadline_ns) return static_cast<double>(worst) * 1e-9;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+void DdsProvisioner::on_restart(int endcap) {
+  std::lock_guard lock(mutex_);
+  if (endcap >= 0 && endcap < static_cast<int>(restarted_at_ns_.size())) restarted_at_ns_[endcap] = ground::Station::now_ns();
+}
+
+void DdsProvisioner::begin_run() {
+  // Lockstep rejoins need no host: start on boot + the stepper's gate.
+  if (config_.mode != StepperMode::realtime || supervisor_.joinable()) return;
+  stopping_ = false;
+  supervisor_ = std::thread([this] {
+    normal_priority();
+    supervise();
+  });
+}
+
+void DdsProvisioner::end_run() {
+  stopping_ = true;
+  if (supervisor_.joinable()) supervisor_.join();
+}
+
+// Real time: a restarted end cap is idle with its stored table. Once it is back on
+// the link, synchronized and with its drives enabled, it gets the run's original
+// start time: it plays its table as far along as the others, in phase.
+void DdsProvisioner::supervise() {
+  while (!stopping_) {
+    std::this_thread::sleep_for(kSupervisePeriod);
+    std::vector<std::pair<int, std::int64_t>> pending;
+    {
+      std::lock_guard lock(mutex_);
+      for (std::size_t e = 0; e < restarted_at_ns_.size(); ++e) {
+        if (restarted_at_ns_[e] != 0) pending.emplace_back(static_cast<int>(e), restarted_at_ns_[e]);
+      }
+    }
+    if (pending.empty()) continue;
+    const auto status = station_->snapshot();
+    for (const auto& [e, since] : pending) {
+      const ground::EndcapStatus& s = status[e];
+      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {
+        // The start command is durable (transient local): a program started again
+        // within command_max_age_s of it takes it from the link's history, and its
+        // start time is the run's. Nothing left to do.
+        std::lock_guard lock(mutex_);
+        if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
+        log_.push_back("dds: end cap " + std::to_string(e) +
+                       " back after a restart: playing again at the run's start time (the start command from the "
+                       "link's history)");
+        continue;
+      }
+      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0) {
+        // Latched while coming back (a sample late while the emulator served the
+        // others): the same clear-fault as before the run's start.
+        clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
+                                  ground::Station::now_ns() + to_ns(config_.command_timeout_s));
+        continue;
+      }
+      const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
+                         s.telemetry_host_ns > since && s.telemetry.drives_enabled() && s.telemetry.mode() == 0 &&
+                         s.telemetry.fault() == 0;
+      if (!ready) continue;
+      // Its phase is as good as its clock: give the time sync a moment.
+      const double round_trip_s = settle_time_sync(static_cast<std::uint16_t>(1U << e),
+                                                   ground::Station::now_ns() + to_ns(config_.rejoin_sync_settle_timeout_s));
+      ground::CommandOptions co;
+      co.endcap_mask = static_cast<std::uint16_t>(1U << e);
+      co.timeout_s = config_.command_timeout_s;
+      const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::start, start_host_ns_, co);
+      char line[300];
+      const double behind_s = static_cast<double>(ground::Station::now_ns() - start_host_ns_) * 1e-9;
+      if (r.all_accepted()) {
+        std::snprintf(line, sizeof line,
+                      "dds: end cap %d back after a restart: started at the run's start time (table %.3f s along; "
+                      "time-sync round trip %.3f ms)",
+                      e, behind_s, round_trip_s * 1e3);
+        std::lock_guard lock(mutex_);
+        if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
+        log_.push_back(line);
+      } else {
+        std::snprintf(line, sizeof line, "dds: end cap %d back after a restart: start not accepted (%s); trying again",
+                      e, r.results.empty() ? "no answer" : r.results[0].text.c_str());
+        note(line);
+      }
+    }
+  }
+}
+
+}  // namespace tensegrity::hil

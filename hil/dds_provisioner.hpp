@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: Apache-2.0
+// The DDS provisioner: the end caps run their DDS link to this host, on a domain
+// of the run's own (DomainLease), and get the policy and the start the way a real
+// robot does: `ground::upload` (the code path of `tensegrity upload`: one table
+// per end cap, acknowledged, re-sent until acknowledged) and a start command with
+// a common host time (`tensegrity start`). Both happen while the stepper holds
+// the end caps with their drives enabled and physics frozen (WorldStepper::hold);
+// the start handshake turns the host time into physics step 0 (start_handshake.hpp).
+//
+// A killed end cap that is started again plays its stored table in phase:
+//  - lockstep: it gets --start-on-boot and the stepper's start gate lets it
+//    through at a policy-period boundary (table time 0 on that exact tick);
+//  - real time: a supervisor thread waits for it to come back (heartbeat, clock
+//    synchronized, drives enabled, idle) and sends it the run's original start
+//    time; an end cap started "in the past" plays its table that far along.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "firmware/comms/endcap_node.hpp"
+#include "hil/dds_domain.hpp"
+#include "hil/provisioner.hpp"
+#include "hil/start_handshake.hpp"
+#include "hil/world_stepper.hpp"
+#include "sim/policy.hpp"
+#include "sim/robot.hpp"
+
+namespace tensegrity::ground {
+class Station;
+}
+
+namespace tensegrity::hil {
+
+struct DdsProvisionerConfig {
+  int domain = -1;                  // -1: lease a free one (DomainLease)
+  std::string host_loss = "continue";  // the end caps' --host-loss
+  StepperMode mode = StepperMode::lockstep;
+  double discovery_timeout_s = 15.0;  // every end cap's heartbeat with a synchronized clock
+  double upload_timeout_s = 10.0;
+  double command_timeout_s = 5.0;
+  // Lockstep: physics step 0 is this many SYNCs after the freeze: a whole number of
+  // the end caps' start grid (endcap_node.hpp), the loops being frozen meanwhile.
+  std::int64_t start_after_ticks = 2 * fw::comms::kLockstepStartGridPeriods;
+  // Real time: the start's host time is this far ahead of the command.
+  double realtime_lead_s = 0.5;
+  // A start is placed through each end cap's time sync, good to half its round
+  // trip: before sending one, wait (at most sync_settle_timeout_s) until every end
+  // cap addressed reports a round trip within this.
+  double max_sync_round_trip_s = 0.002;
+  double sync_settle_timeout_s = 5.0;
+  double rejoin_sync_settle_timeout_s = 1.0;  // a restarted end cap: every second out of the gait counts
+};
+
+class DdsProvisioner final : public Provisioner {
+ public:
+  // Creates the host's DDS participant at once (before the end caps start, so
+  // discovery runs during their boot; and on the caller's scheduling class).
+  DdsProvisioner(const sim::Robot& robot, const sim::Policy& policy, const std::filesystem::path& policy_file,
+                 const DdsProvisionerConfig& config);
+  ~DdsProvisioner() override;
+
+  std::string name() const override;
+  std::vector<std::string> endcap_arguments(int endcap, bool restart) const override;
+  bool needs_hold() const override { return true; }
+  void provision(const ProcessLauncher&) override {}
+  void start(const ProcessLauncher&) override {}
+  void deliver(StartHandshake& handshake) override;
+  void begin_run() override;
+  void end_run() override;
+  bool dds_link() const override { return true; }
+  void on_restart(int endcap) override;
+  std::vector<std::string> log() const override;
+
+  int domain() const { return lease_.domain(); }
+
+ private:
+  void supervise();
+  // End caps of `mask` that report a latched fault get one clear-fault (the
+  // operator's `tensegrity clear-fault` before a start), logged; returns false if
+  // one is still faulted by `deadline_ns`.
+  bool clear_faults_before_start(std::uint16_t mask, std::int64_t deadline_ns);
+  // Waits until every end cap of `mask` reports a time-sync round trip within
+  // max_sync_round_trip_s, at most until `deadline_ns`; returns the worst one seen.
+  double settle_time_sync(std::uint16_t mask, std::int64_t deadline_ns) const;
+  void note(const std::string& line);
+
+  const sim::Robot& robot_;
+  const sim::Policy& policy_;
+  std::string policy_id_;
+  DdsProvisionerConfig config_;
+  DomainLease lease_;
+  std::unique_ptr<ground::Station> station_;
+  std::int64_t start_host_ns_ = 0;  // the run's start (host time of table time 0)
+
+  mutable std::mutex mutex_;
+  std::vector<std::string> log_;
+  std::vector<std::int64_t> restarted_at_ns_;  // per end cap: host time of a restart not yet started (0: none)
+  std::atomic<bool> stopping_{false};
+  std::thread supervisor_;
+};
+
+}  // namespace tensegrity::hil

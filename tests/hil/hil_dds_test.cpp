@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: Apache-2.0
+// The HIL's DDS link: errors naming an end cap missing from the link, and the
+// link cut and restored during the run. With --host-loss continue an open-loop
+// gait does not notice (in lockstep the run is identical to an uncut one); with
+// stop the end caps stop when they lose the host.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "sim/core_controller.hpp"
+#include "sim/episode.hpp"
+#include "tests/hil/hil_test_support.hpp"
+
+namespace tensegrity::hil {
+namespace {
+
+using namespace hil_test;
+
+ScenarioEvent link_event(double time_s, FaultKind fault) {
+  ScenarioEvent e;
+  e.time_s = time_s;
+  e.endcap = -1;  // every end cap: the host's link
+  e.fault = fault;
+  return e;
+}
+
+TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
+  HilOptions o = options(1.0, Provision::dds);
+  o.endcap_extra_args[7] = {"--no-dds"};  // boots on its bus, never joins DDS
+  o.dds_discovery_timeout_s = 3.0;
+  const HilResult r = run_hil(o);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("no heartbeat from end cap(s) 7 "), std::string::npos) << r.error;
+  EXPECT_TRUE(child_pids().empty());
+}
+
+TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
+  const double duration_s = 50.0;
+  sim::CoreController reference(robot(), sim::load_policy(evolved_policy_file(), robot()));
+  sim::EpisodeOptions eo;
+  eo.duration_s = duration_s;
+  const sim::EpisodeResult ref = sim::run_episode(robot(), reference, eo);
+
+  HilOptions o = options(duration_s, Provision::dds);
+  o.policy = evolved_policy_file();
+  o.host_loss = "continue";
+  // Long in physics time: the end caps judge host loss on the wall clock (1 s),
+  // and lockstep runs several times faster than that.
+  o.scenario.events = {link_event(2.0, FaultKind::cut_dds), link_event(42.0, FaultKind::restore_dds)};
+  double at_cut = 0.0, at_restore = 0.0;
+  o.after_step = [&](const WorldStepper& s, ProcessLauncher&) {
+    if (s.step_index() == 2000) at_cut = s.distance_m();
+    if (s.step_index() == 42000) at_restore = s.distance_m();
+  };
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  for (const auto& e : r.endcaps) {
+    EXPECT_EQ(e.link_cuts, 1) << "end cap " << e.endcap;
+    EXPECT_GE(e.host_losses, 1) << "end cap " << e.endcap << " never noticed the host was gone";
+    EXPECT_EQ(e.host_returns, e.host_losses) << "end cap " << e.endcap << " did not see the host come back";
+    EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
+  }
+  EXPECT_GT(at_restore, at_cut + 1.0) << "the gait kept rolling while the link was cut";
+  // Open loop and lockstep: the physics never knew the link was gone (the same
+  // run as in-process, up to the drives' position quantisation: ~1e-7 relative).
+  EXPECT_NEAR(r.distance_m, ref.distance_m, 1e-5 * ref.distance_m);
+  EXPECT_EQ(r.playing, 12);
+  EXPECT_EQ(r.max_phase_offset_s, 0.0);
+  std::printf("link cut, continue: %.3f m at the cut, %.3f m at the restore, %.3f m at the end (in-process %.3f m)\n",
+              at_cut, at_restore, r.distance_m, ref.distance_m);
+}
+
+TEST(HilDds, LinkCutWithStopStopsTheGait) {
+  const double duration_s = 40.0;
+  HilOptions o = options(duration_s, Provision::dds);
+  o.policy = evolved_policy_file();
+  o.host_loss = "stop";
+  o.scenario.events = {link_event(2.0, FaultKind::cut_dds), link_event(38.0, FaultKind::restore_dds)};
+  std::vector<double> distance_by_s;
+  o.after_step = [&](const WorldStepper& s, ProcessLauncher&) {
+    if (s.step_index() % 1000 == 0) distance_by_s.push_back(s.distance_m());
+  };
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  for (const auto& e : r.endcaps) {
+    EXPECT_EQ(e.link_cuts, 1) << "end cap " << e.endcap;
+    EXPECT_GE(e.host_losses, 1) << "end cap " << e.endcap;
+    EXPECT_FALSE(e.playing) << "end cap " << e.endcap << " still playing after losing the host";
+    EXPECT_EQ(e.fault, "none") << "a stop is not a fault: end cap " << e.endcap;
+  }
+  EXPECT_EQ(r.playing, 0);
+  ASSERT_EQ(distance_by_s.size(), 40u);
+  // Stopped (each end cap holds its cables) and settled well before the end.
+  EXPECT_LT(std::abs(distance_by_s[39] - distance_by_s[29]), 0.05)
+      << "still moving: " << ::testing::PrintToString(distance_by_s);
+  std::printf("link cut, stop: distance at 2, 10, 20, 30, 40 s: %.3f %.3f %.3f %.3f %.3f m\n", distance_by_s[1],
+              distance_by_s[9], distance_by_s[19], distance_by_s[29], distance_by_s[39]);
+}
+
+}  // namespace
+}  // namespace tensegrity::hil

@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: Apache-2.0
+// A killed end cap, started again, plays its stored policy in phase with the
+// other eleven: lockstep through the stepper's start gate on a period boundary
+// (both provisioners), real time through a DDS start at the run's start time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "tests/hil/hil_test_support.hpp"
+
+namespace tensegrity::hil {
+namespace {
+
+using namespace hil_test;
+
+struct RejoinCase {
+  StepperMode mode;
+  Provision provision;
+  double tolerance_s;  // phase agreement required of every end cap
+};
+
+class HilRejoin : public ::testing::TestWithParam<RejoinCase> {};
+
+TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
+  const RejoinCase c = GetParam();
+  // Real time: killed late enough that the start command in the link's history is
+  // older than the end caps' replay limit (5 s): the provisioner itself has to
+  // start the new program, at the run's start time.
+  const double kill_s = c.mode == StepperMode::lockstep ? 1.0 : 5.5;
+  HilOptions o = options(10.0, c.provision);
+  o.mode = c.mode;
+  ScenarioEvent kill;
+  kill.time_s = kill_s;
+  kill.endcap = 4;
+  kill.fault = FaultKind::kill_endcap;
+  ScenarioEvent restart = kill;
+  restart.time_s = kill_s + 0.5;
+  restart.fault = FaultKind::restart_endcap;
+  o.scenario.events = {kill, restart};
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  const EndcapSummary& e4 = r.endcaps.at(4);
+  EXPECT_EQ(e4.restarts, 1u);
+  EXPECT_EQ(r.stats.rejoins, 1);
+  EXPECT_EQ(e4.fault, "none");
+  EXPECT_EQ(e4.devices.drive_states.at(0), "operation enabled");
+  bool rejoined = false;
+  for (const auto& line : r.log) {
+    // Lockstep: the policy period is 4 s = 4000 steps, the gate opens at a multiple
+    // (4000 unless the new program took more than 2.5 s of physics time to boot).
+    const std::string gate = "end cap 4 enabled again (table time 0 at step ";
+    if (const auto at = line.find(gate); c.mode == StepperMode::lockstep && at != std::string::npos) {
+      const long step = std::stol(line.substr(at + gate.size()));
+      EXPECT_EQ(step % 4000, 0) << line;
+      rejoined = true;
+    }
+    if (c.mode == StepperMode::realtime &&
+        line.find("end cap 4 back after a restart: started at the run's start time") != std::string::npos) {
+      rejoined = true;
+    }
+  }
+  EXPECT_TRUE(rejoined) << ::testing::PrintToString(r.log);
+  // The table phases themselves, as the end caps report them at exit.
+  EXPECT_EQ(r.playing, 12) << ::testing::PrintToString(r.log);
+  for (const auto& e : r.endcaps) {
+    EXPECT_TRUE(e.playing) << "end cap " << e.endcap << " (fault: " << e.fault << ")";
+    EXPECT_LE(std::abs(e.phase_offset_s), c.tolerance_s) << "end cap " << e.endcap << " out of phase";
+  }
+  EXPECT_TRUE(child_pids().empty());
+  std::printf("rejoin (%s, %s): end cap 4 phase %+.3f ms, worst of all %.3f ms\n", to_string(c.mode),
+              to_string(c.provision), e4.phase_offset_s * 1e3, r.max_phase_offset_s * 1e3);
+}
+
+#ifdef TENSEGRITY_HIL_DDS
+// Real time: the time sync error (ms on a loaded host) plus a loop period.
+#define HIL_REJOIN_CASES                                                              \
+  RejoinCase{StepperMode::lockstep, Provision::local, 0.0},                           \
+      RejoinCase{StepperMode::lockstep, Provision::dds, 0.0},                         \
+      RejoinCase{StepperMode::realtime, Provision::dds, 0.005}
+#else
+#define HIL_REJOIN_CASES RejoinCase{StepperMode::lockstep, Provision::local, 0.0}
+#endif
+INSTANTIATE_TEST_SUITE_P(Modes, HilRejoin, ::testing::Values(HIL_REJOIN_CASES),
+                         [](const ::testing::TestParamInfo<RejoinCase>& i) {
+                           return std::string(to_string(i.param.mode)) + "_" + to_string(i.param.provision);
+                         });
+
+}  // namespace
+}  // namespace tensegrity::hil
