@@ -211,6 +211,19 @@ TEST(ControlLoop, LockstepRunsExactlyOneCyclePerSyncAndSendsNone) {
   EXPECT_EQ(b.loop->status().time_ns, static_cast<std::int64_t>(cycles + 2) * b.settings.period_ns);
   EXPECT_EQ(b.bus.syncs_sent, 0U) << "the end cap must not produce SYNC in lockstep";
   EXPECT_EQ(b.loop->master().sync().received, cycles + 2);
+  EXPECT_EQ(b.bus.flushes, b.loop->status().cycles) << "a batching bus sends once per cycle";
+}
+
+TEST(ControlLoop, FlushesTheBusOncePerCycleAfterItsLastFrame) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  const std::uint64_t cycles = b.loop->status().cycles;
+  const std::uint64_t flushes = b.bus.flushes;
+  const std::uint64_t syncs = b.bus.syncs_sent;
+  for (int i = 0; i < 10; ++i) b.cycle();
+  EXPECT_EQ(b.loop->status().cycles - cycles, 10U);
+  EXPECT_EQ(b.bus.flushes - flushes, 10U);
+  EXPECT_EQ(b.bus.syncs_sent - syncs, 10U) << "targets and SYNC before the flush";
 }
 
 }  // namespace
