@@ -1,0 +1,332 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+"""Regenerate the paper's learning figures (6-9) on this model.
+
+Runs `tensegrity evolve` for every (method, period, complexity, seed) the
+figures need, several at a time, and writes per figure a CSV and a PNG:
+
+  fig6_methods.csv/png      historical vs leniency vs average (t = 4 s, n = 5):
+                            best-so-far and mean team score per generation
+  fig7_learning.csv/png     historical, t = 4 s, n = 5: best-so-far and the
+                            infeasible rate per generation
+  fig8_period.csv/png       n = 5, t = 2..8 s: the best team of each run
+  fig9_complexity.csv/png   t = 4 s, n = 2..8: the best team of each run
+  summary.json              the numbers above, aggregated over seeds
+
+Error bars are the standard deviation over seeds. A run is identified by its
+parameters; it checkpoints every generation into OUT/runs/<id>/, so the script
+can be stopped and started again: finished runs are reused, unfinished ones
+resume where they stopped. Runs shared by several figures (historical, t = 4 s,
+n = 5) are done once.
+
+Examples:
+  tools/experiments.py --out out/experiments                 # the paper's budget
+  tools/experiments.py --out out/quick --seeds 2 --episodes 1000 --sweep-episodes 500
+  tools/experiments.py --out out/experiments --plot-only     # redraw from the runs
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import os
+import pathlib
+import statistics
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+# What the paper reports (Iscen et al., sections 5-6), for the plots and the page.
+PAPER_PERIOD_M = {4: 33.0, 5: 27.0, 6: 22.5, 7: 19.0, 8: 18.0}
+PAPER_BEST_T4_N5_M = 32.0
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", default="out/experiments", help="output directory (default: %(default)s)")
+    p.add_argument("--tensegrity", default=str(ROOT / "build/release/cli/tensegrity"),
+                   help="the tensegrity program (default: %(default)s)")
+    p.add_argument("--robot", default=str(ROOT / "robots/superball.json"), help="robot description")
+    p.add_argument("--seeds", type=int, default=5, help="seeds per configuration, 1..N (default: %(default)s)")
+    p.add_argument("--first-seed", type=int, default=1, help="first seed (default: %(default)s)")
+    p.add_argument("--episodes", type=int, default=5000,
+                   help="episodes per run for figures 6 and 7 (default: %(default)s)")
+    p.add_argument("--sweep-episodes", type=int, default=None,
+                   help="episodes per run for the sweeps, figures 8 and 9 (default: --episodes)")
+    p.add_argument("--periods", default="2,3,4,5,6,7,8", help="figure 8 periods, s (default: %(default)s)")
+    p.add_argument("--complexities", default="2,3,4,5,6,7,8", help="figure 9 complexities (default: %(default)s)")
+    p.add_argument("--figures", default="6,7,8,9", help="which figures (default: %(default)s)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="evolutions at once, one thread each (default: the cores, %(default)s)")
+    p.add_argument("--duration", type=float, default=60.0,
+                   help="episode length, s (default: the paper's %(default)s; shorter only for smoke tests)")
+    p.add_argument("--plot-only", action="store_true", help="do not run anything; plot what is there")
+    a = p.parse_args()
+    a.sweep_episodes = a.sweep_episodes or a.episodes
+    a.periods = [float(x) for x in a.periods.split(",") if x]
+    a.complexities = [int(x) for x in a.complexities.split(",") if x]
+    a.figures = {int(x) for x in a.figures.split(",") if x}
+    if a.seeds < 1 or a.episodes < 1 or a.jobs < 1:
+        p.error("--seeds, --episodes and --jobs must be positive")
+    return a
+
+
+def run_id(method, period, complexity, episodes, seed, duration):
+    tail = "" if duration == 60.0 else f"-d{duration:g}"
+    return f"{method}-t{period:g}-n{complexity}-e{episodes}-s{seed}{tail}"
+
+
+def plan(a):
+    """The set of runs the selected figures need (deduplicated)."""
+    seeds = range(a.first_seed, a.first_seed + a.seeds)
+    runs = {}
+
+    def add(method, period, complexity, episodes, seed):
+        key = run_id(method, period, complexity, episodes, seed, a.duration)
+        runs[key] = dict(method=method, period=period, complexity=complexity, episodes=episodes, seed=seed)
+
+    for s in seeds:
+        if 6 in a.figures:
+            for m in ("historical", "leniency", "average"):
+                add(m, 4.0, 5, a.episodes, s)
+        if 7 in a.figures:
+            add("historical", 4.0, 5, a.episodes, s)
+        if 8 in a.figures:
+            for t in a.periods:
+                add("historical", t, 5, a.sweep_episodes, s)
+        if 9 in a.figures:
+            for n in a.complexities:
+                add("historical", 4.0, n, a.sweep_episodes, s)
+    return runs
+
+
+def run_one(a, key, r, progress):
+    d = pathlib.Path(a.out) / "runs" / key
+    d.mkdir(parents=True, exist_ok=True)
+    summary = d / "summary.json"
+    if summary.exists():
+        progress(key, "done already")
+        return
+    ckpt = d / "checkpoint"
+    cmd = [a.tensegrity, "evolve", "--robot", a.robot, "--method", r["method"], "--period", f"{r['period']:g}",
+           "--complexity", str(r["complexity"]), "--episodes", str(r["episodes"]), "--seed", str(r["seed"]),
+           "--duration", f"{a.duration:g}", "--threads", "1", "--checkpoint", str(ckpt), "--out", str(d / "policy.json"),
+           "--log", str(d / "curve.csv"), "--json"]
+    if (ckpt / "checkpoint.json").exists():
+        cmd.append("--resume")
+    progress(key, "started")
+    t0 = time.monotonic()
+    done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{key}: tensegrity evolve failed ({done.returncode}): {done.stderr.strip()}")
+    result = json.loads(done.stdout)
+    result.update(r)
+    tmp = summary.with_suffix(".tmp")
+    tmp.write_text(json.dumps(result, indent=2) + "\n")
+    tmp.replace(summary)
+    progress(key, f"best {result['final_score_m']:.2f} m in {time.monotonic() - t0:.0f} s")
+
+
+def run_all(a, runs):
+    lock = threading.Lock()
+    finished = [0]
+
+    def progress(key, what):
+        with lock:
+            if what != "started":
+                finished[0] += 1
+            print(f"[{finished[0]}/{len(runs)}] {key}: {what}", flush=True)
+
+    failures = []
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        futures = {pool.submit(run_one, a, k, r, progress): k for k, r in runs.items()}
+        for f in concurrent.futures.as_completed(futures):
+            try:
+                f.result()
+            except Exception as e:  # one failed run must not lose the others
+                failures.append(str(e))
+                print(f"experiments: {e}", file=sys.stderr, flush=True)
+    return failures
+
+
+def read_curve(path):
+    with open(path) as f:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def load(a, runs):
+    out = {}
+    for key, r in runs.items():
+        d = pathlib.Path(a.out) / "runs" / key
+        if (d / "summary.json").exists():
+            out[key] = dict(r, summary=json.loads((d / "summary.json").read_text()), curve=read_curve(d / "curve.csv"))
+    return out
+
+
+def mean_sd(values):
+    if not values:
+        return float("nan"), float("nan")
+    return statistics.fmean(values), (statistics.stdev(values) if len(values) > 1 else 0.0)
+
+
+def curves_by_generation(done, method, period, complexity, episodes, column):
+    """Per generation: episodes, mean and sd over the seeds that reached it."""
+    series = [d["curve"] for d in done.values()
+              if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)]
+    rows = []
+    for g in range(max((len(c) for c in series), default=0)):
+        vals = [c[g][column] for c in series if g < len(c)]
+        eps = next(c[g]["episodes"] for c in series if g < len(c))
+        m, sd = mean_sd(vals)
+        rows.append((g + 1, eps, m, sd, len(vals)))
+    return rows
+
+
+def finals(done, method, period, complexity, episodes):
+    return [d["summary"]["final_score_m"] for d in done.values()
+            if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)]
+
+
+def write_csv(path, header, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+
+
+def report(a, runs):
+    done = load(a, runs)
+    out = pathlib.Path(a.out)
+    summary = {"episodes": a.episodes, "sweep_episodes": a.sweep_episodes, "seeds": a.seeds, "robot": a.robot}
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        plt = None
+        print("experiments: matplotlib missing (Debian: python3-matplotlib; run with /usr/bin/python3): CSV only",
+              file=sys.stderr)
+
+    if 6 in a.figures:
+        rows, fig_data, summary["methods"] = [], {}, {}
+        for m in ("historical", "leniency", "average"):
+            best = curves_by_generation(done, m, 4.0, 5, a.episodes, "best_so_far_m")
+            mean = curves_by_generation(done, m, 4.0, 5, a.episodes, "mean_score_m")
+            fig_data[m] = (best, mean)
+            for b, mm in zip(best, mean):
+                rows.append((m, b[0], int(b[1]), f"{b[2]:.4f}", f"{b[3]:.4f}", f"{mm[2]:.4f}", f"{mm[3]:.4f}", b[4]))
+            f_mean, f_sd = mean_sd(finals(done, m, 4.0, 5, a.episodes))
+            last_mean = mean[-1][2] if mean else float("nan")
+            summary["methods"][m] = {"best_m": f_mean, "best_sd_m": f_sd, "last_generation_mean_m": last_mean,
+                                     "runs": len(finals(done, m, 4.0, 5, a.episodes))}
+        write_csv(out / "fig6_methods.csv", ["method", "generation", "episodes", "best_so_far_m", "best_so_far_sd_m",
+                                             "mean_score_m", "mean_score_sd_m", "seeds"], rows)
+        if plt:
+            fig, ax = plt.subplots(figsize=(8, 5))
+            for m, colour in zip(fig_data, ("C0", "C1", "C2")):
+                best, mean = fig_data[m]
+                if not best:
+                    continue
+                x = [r[1] for r in best]
+                ax.plot(x, [r[2] for r in best], color=colour, label=f"{m}: best so far")
+                ax.fill_between(x, [r[2] - r[3] for r in best], [r[2] + r[3] for r in best], color=colour, alpha=0.15)
+                ax.plot(x, [r[2] for r in mean], color=colour, linestyle="--", label=f"{m}: mean of generation")
+            ax.set_xlabel("episodes")
+            ax.set_ylabel("distance in 60 s, m")
+            ax.set_title(f"Figure 6: fitness methods (t = 4 s, n = 5, {a.seeds} seeds, band = 1 sd)")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            fig.savefig(out / "fig6_methods.png", dpi=110)
+            plt.close(fig)
+
+    if 7 in a.figures:
+        best = curves_by_generation(done, "historical", 4.0, 5, a.episodes, "best_so_far_m")
+        inf = curves_by_generation(done, "historical", 4.0, 5, a.episodes, "infeasible_rate")
+        write_csv(out / "fig7_learning.csv", ["generation", "episodes", "best_so_far_m", "best_so_far_sd_m",
+                                              "infeasible_rate", "infeasible_rate_sd", "seeds"],
+                  [(b[0], int(b[1]), f"{b[2]:.4f}", f"{b[3]:.4f}", f"{i[2]:.4f}", f"{i[3]:.4f}", b[4])
+                   for b, i in zip(best, inf)])
+        f_mean, f_sd = mean_sd(finals(done, "historical", 4.0, 5, a.episodes))
+        reach = [next((int(r["episodes"]) for r in d["curve"] if r["best_so_far_m"] >= PAPER_BEST_T4_N5_M), None)
+                 for d in done.values()
+                 if (d["method"], d["period"], d["complexity"], d["episodes"]) == ("historical", 4.0, 5, a.episodes)]
+        summary["learning"] = {"best_m": f_mean, "best_sd_m": f_sd, "paper_m": PAPER_BEST_T4_N5_M,
+                               "episodes_to_32m": reach,
+                               "infeasible_rate_last": inf[-1][2] if inf else None}
+        if plt and best:
+            fig, ax = plt.subplots(figsize=(8, 5))
+            x = [r[1] for r in best]
+            ax.errorbar(x, [r[2] for r in best], yerr=[r[3] for r in best], color="C0", errorevery=max(1, len(x) // 20),
+                        capsize=2, label="best so far, m")
+            ax.axhline(PAPER_BEST_T4_N5_M, color="grey", linestyle=":", label="paper: 32 m")
+            ax.set_xlabel("episodes")
+            ax.set_ylabel("distance in 60 s, m")
+            ax2 = ax.twinx()
+            ax2.plot(x, [100 * r[2] for r in inf], color="C3", alpha=0.7, label="infeasible, %")
+            ax2.set_ylabel("infeasible teams, %")
+            ax2.set_ylim(0, 100)
+            h1, l1 = ax.get_legend_handles_labels()
+            h2, l2 = ax2.get_legend_handles_labels()
+            ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="center right")
+            ax.set_title(f"Figure 7: learning, historical average, t = 4 s, n = 5 ({a.seeds} seeds)")
+            ax.grid(alpha=0.3)
+            fig.tight_layout()
+            fig.savefig(out / "fig7_learning.png", dpi=110)
+            plt.close(fig)
+
+    def sweep(name, fig_no, keys, label, paper):
+        rows, xs, ms, sds = [], [], [], []
+        for x, (period, n) in keys:
+            vals = finals(done, "historical", period, n, a.sweep_episodes)
+            m, sd = mean_sd(vals)
+            rows.append((f"{x:g}", f"{m:.4f}", f"{sd:.4f}", len(vals), paper.get(x, "")))
+            if vals:
+                xs.append(x), ms.append(m), sds.append(sd)
+        write_csv(out / f"fig{fig_no}_{name}.csv", [label, "best_m", "best_sd_m", "seeds", "paper_m"], rows)
+        summary[name] = {f"{r[0]}": {"best_m": float(r[1]), "best_sd_m": float(r[2]), "seeds": r[3]} for r in rows}
+        if plt and xs:
+            fig, ax = plt.subplots(figsize=(7, 4.5))
+            ax.errorbar(xs, ms, yerr=sds, fmt="o-", capsize=3, label=f"this model ({a.seeds} seeds, "
+                                                                       f"{a.sweep_episodes} episodes)")
+            if paper:
+                ax.plot(list(paper), list(paper.values()), "s:", color="grey", label="paper")
+            ax.set_xlabel(label.replace("_", " "))
+            ax.set_ylabel("distance in 60 s, m")
+            ax.set_title(f"Figure {fig_no}: {name} sweep")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+            fig.tight_layout()
+            fig.savefig(out / f"fig{fig_no}_{name}.png", dpi=110)
+            plt.close(fig)
+
+    if 8 in a.figures:
+        sweep("period", 8, [(t, (t, 5)) for t in a.periods], "period_s", PAPER_PERIOD_M)
+    if 9 in a.figures:
+        sweep("complexity", 9, [(n, (4.0, n)) for n in a.complexities], "complexity", {})
+
+    summary["runs_done"], summary["runs_planned"] = len(done), len(runs)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    print(json.dumps(summary, indent=2))
+
+
+def main():
+    a = parse_args()
+    pathlib.Path(a.out).mkdir(parents=True, exist_ok=True)
+    runs = plan(a)
+    failures = []
+    if not a.plot_only:
+        if not os.access(a.tensegrity, os.X_OK):
+            sys.exit(f"experiments: {a.tensegrity} is not an executable (build: cmake --preset release && "
+                     f"cmake --build --preset release --target tensegrity)")
+        print(f"experiments: {len(runs)} runs, {a.jobs} at a time, into {a.out}", flush=True)
+        failures = run_all(a, runs)
+    report(a, runs)
+    if failures:
+        sys.exit(f"experiments: {len(failures)} run(s) failed")
+
+
+if __name__ == "__main__":
+    main()
