@@ -8,8 +8,9 @@
 // Fixed buckets, no allocation after construction.
 #pragma once
 
-#include <array>
 #include <cstdint>
+
+#include "firmware/core/histogram.hpp"
 
 namespace tensegrity::hil {
 
@@ -24,9 +25,6 @@ struct LatenessSummary {
 
 class LatenessStats {
  public:
-  static constexpr std::int64_t kBucketNs = 10'000;
-  static constexpr std::size_t kBuckets = 2'000;  // 20 ms; anything later lands in the last
-
   LatenessStats(std::int64_t period_ns, std::int64_t late_after_ns)
       : period_ns_(period_ns), late_after_ns_(late_after_ns) {}
 
@@ -35,12 +33,10 @@ class LatenessStats {
   LatenessSummary summary() const noexcept;
 
  private:
-  std::int64_t quantile_ns(double q) const noexcept;
-
   std::int64_t period_ns_;
   std::int64_t late_after_ns_;
-  std::array<std::uint32_t, kBuckets> buckets_{};
-  std::int64_t count_ = 0, late_ = 0, episodes_ = 0, missed_ = 0, max_ns_ = 0;
+  core::FixedHistogram<10'000, 2'000> histogram_;  // 10 us buckets to 20 ms
+  std::int64_t late_ = 0, episodes_ = 0, missed_ = 0;
   bool previous_late_ = false;
 };
 
