@@ -72,7 +72,7 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
   o.host_loss = a.host_loss;
   o.dds_domain = a.domain;
-  const sim::Robot robot = a.robot.empty() ? sim::load_robot(sim::default_robot_path()) : sim::load_robot(a.robot);
+  const sim::Robot robot = sim::load_robot(a.robot.empty() ? sim::robot_path_for_policy(o.policy) : std::filesystem::path(a.robot));
   try {
     if (!a.scenario.empty()) o.scenario = hil::load_scenario(a.scenario, robot.endcap_count());
     for (const auto& f : a.faults) o.scenario.events.push_back(hil::parse_fault_option(f, robot.endcap_count()));
@@ -105,7 +105,7 @@ void run_hil_command(const HilArgs& args) {
 void add_hil_command(CLI::App& app) {
   auto args = std::make_shared<HilArgs>();
   CLI::App* cmd = app.add_subcommand("hil", "Run the HIL emulator with 12 end-cap firmware processes");
-  cmd->add_option("--robot", args->robot, "Robot description (default: robots/superball.json)")->check(CLI::ExistingFile);
+  cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names)")->check(CLI::ExistingFile);
   cmd->add_option("--policy", args->policy, "Policy file (default: policies/superball-t4-n5.json)")->check(CLI::ExistingFile);
   cmd->add_option("--duration", args->duration_s, "Physics time, seconds")->capture_default_str()->check(CLI::Range(0.001, 86400.0));
   cmd->add_option("--mode", args->mode, "lockstep (the emulator owns time) or realtime (1 kHz wall clock)")

@@ -27,7 +27,7 @@ struct SimArgs {
 };
 
 void run_sim(const SimArgs& args) {
-  const sim::Robot robot = load_robot_arg(args.robot);
+  const sim::Robot robot = load_robot_arg(args.robot, args.policy);
   std::unique_ptr<sim::Controller> controller;
   std::string controller_name;
   sim::EpisodeOptions options;
@@ -71,7 +71,7 @@ void run_sim(const SimArgs& args) {
 void add_sim_command(CLI::App& app) {
   auto args = std::make_shared<SimArgs>();
   CLI::App* cmd = app.add_subcommand("sim", "Run one episode of the robot model and summarise it");
-  cmd->add_option("--robot", args->robot, "Robot description (default: robots/superball.json)")
+  cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names, else robots/superball.json)")
       ->check(CLI::ExistingFile);
   auto* policy = cmd->add_option("--policy", args->policy, "Policy file to play (tensegrity-policy/1)")
                      ->check(CLI::ExistingFile);

@@ -24,7 +24,7 @@ void add_upload_command(CLI::App& app) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand("upload", "Send a policy to the end caps and wait for every acknowledgement");
   cmd->add_option("policy", args->policy, "Policy file (tensegrity-policy/1)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--robot", args->robot, "Robot file (default: robots/superball.json)")->check(CLI::ExistingFile);
+  cmd->add_option("--robot", args->robot, "Robot file (default: the one the policy names)")->check(CLI::ExistingFile);
   cmd->add_option("--id", args->id, "Policy id (default: the file name without extension; at most 64 chars)");
   cmd->add_option("--policy-version", args->version,
                   "Policy version; must exceed the active one (default: Unix time in seconds)")
@@ -32,7 +32,7 @@ void add_upload_command(CLI::App& app) {
   cmd->add_flag("--force", args->force, "Accept a version not newer than the active one");
   add_ground_options(*cmd, args->ground, 10.0);
   cmd->callback([args] {
-    const sim::Robot robot = sim::load_robot(args->robot.empty() ? sim::default_robot_path() : std::filesystem::path(args->robot));
+    const sim::Robot robot = sim::load_robot(args->robot.empty() ? sim::robot_path_for_policy(args->policy) : std::filesystem::path(args->robot));
     const sim::Policy policy = sim::load_policy(args->policy, robot);
     fw::comms::PolicyIdentity identity;
     identity.policy_id = args->id.empty() ? std::filesystem::path(args->policy).stem().string() : args->id;

@@ -8,8 +8,9 @@
 
 namespace tensegrity::cli {
 
-sim::Robot load_robot_arg(const std::string& path) {
-  return sim::load_robot(path.empty() ? sim::default_robot_path() : std::filesystem::path(path));
+sim::Robot load_robot_arg(const std::string& path, const std::string& policy) {
+  if (!path.empty()) return sim::load_robot(path);
+  return sim::load_robot(policy.empty() ? sim::default_robot_path() : sim::robot_path_for_policy(policy));
 }
 
 nlohmann::json episode_json(const sim::EpisodeResult& r) {

@@ -12,7 +12,8 @@
 namespace tensegrity::cli {
 
 // The robot of a --robot option; the shipped default when empty.
-sim::Robot load_robot_arg(const std::string& path);
+// `path`, else the robot `policy` names (when one is given), else the default robot.
+sim::Robot load_robot_arg(const std::string& path, const std::string& policy = "");
 nlohmann::json episode_json(const sim::EpisodeResult& result);
 void print_episode_summary(const sim::EpisodeResult& result);
 std::unique_ptr<sim::Controller> make_policy_controller(const sim::Robot& robot, const std::string& path);

@@ -178,7 +178,9 @@ HilResult run_hil(const HilOptions& options) {
   bool running = false;
   try {
     robot_ptr = std::make_unique<sim::Robot>(
-        sim::load_robot(options.robot.empty() ? sim::default_robot_path() : options.robot));
+        sim::load_robot(!options.robot.empty() ? options.robot
+                        : options.policy.empty() ? sim::default_robot_path()
+                                                 : sim::robot_path_for_policy(options.policy)));
     const sim::Robot& robot = *robot_ptr;
     if (options.policy.empty()) throw HilError("no policy file (--policy)");
     policy_ptr = std::make_unique<sim::Policy>(sim::load_policy(options.policy, robot));  // fail early, with the field

@@ -124,6 +124,23 @@ Policy load_policy(const std::filesystem::path& path, const Robot& robot) {
   return parse_policy(buffer.str(), robot, path.string());
 }
 
+std::filesystem::path robot_path_for_policy(const std::filesystem::path& policy_path) {
+  std::ifstream in(policy_path);
+  const json doc = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (doc.is_object()) {
+    const auto it = doc.find("robot");
+    // A name, not a path: nothing outside the robots directory is reachable from a file.
+    if (it != doc.end() && it->is_string()) {
+      const std::string name = it->get<std::string>();
+      if (!name.empty() && name.find_first_of("/\\") == std::string::npos && name.front() != '.') {
+        const std::filesystem::path path = robot_path_named(name);
+        if (std::filesystem::exists(path)) return path;
+      }
+    }
+  }
+  return default_robot_path();
+}
+
 std::string policy_to_json(const Policy& policy) {
   json cables = json::array();
   for (const auto& c : policy.cables) {

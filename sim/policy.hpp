@@ -47,6 +47,10 @@ struct Policy {
 Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source = "policy");
 Policy load_policy(const std::filesystem::path& path, const Robot& robot);
 std::string policy_to_json(const Policy& policy);
+// The robot a policy file was made for, when no robot is given: robots/<its "robot">.json
+// when that file exists, else the default robot (whose name check then says what is
+// wrong). The policy names its robot, so playing it needs no --robot.
+std::filesystem::path robot_path_for_policy(const std::filesystem::path& policy_path);
 // Writes to a temporary file beside `path`, then renames: never a half-written policy.
 void save_policy(const std::filesystem::path& path, const Policy& policy);
 

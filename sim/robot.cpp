@@ -240,15 +240,16 @@ Robot load_robot(const std::filesystem::path& path) {
   return parse_robot(buffer.str(), path.string());
 }
 
-std::filesystem::path default_robot_path() {
-  if (const char* dir = std::getenv("TENSEGRITY_ROBOTS_DIR")) {
-    return std::filesystem::path(dir) / "superball.json";
-  }
+std::filesystem::path robot_path_named(const std::string& name) {
+  const std::string file = name + ".json";
+  if (const char* dir = std::getenv("TENSEGRITY_ROBOTS_DIR")) return std::filesystem::path(dir) / file;
 #ifdef TENSEGRITY_SOURCE_ROBOTS_DIR
-  const std::filesystem::path built_from = std::filesystem::path(TENSEGRITY_SOURCE_ROBOTS_DIR) / "superball.json";
+  const std::filesystem::path built_from = std::filesystem::path(TENSEGRITY_SOURCE_ROBOTS_DIR) / file;
   if (std::filesystem::exists(built_from)) return built_from;
 #endif
-  return std::filesystem::path("robots") / "superball.json";
+  return std::filesystem::path("robots") / file;
 }
+
+std::filesystem::path default_robot_path() { return robot_path_named("superball"); }
 
 }  // namespace tensegrity::sim

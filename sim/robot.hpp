@@ -65,8 +65,10 @@ struct Robot {
 // Parses and validates; errors name the source and the JSON path of the bad field.
 Robot parse_robot(const std::string& json_text, const std::string& source = "robot");
 Robot load_robot(const std::filesystem::path& path);
-// The shipped default: robots/superball.json, found via TENSEGRITY_ROBOTS_DIR, the
-// source tree this binary was built from, or ./robots.
+// robots/<name>.json, found via TENSEGRITY_ROBOTS_DIR, the source tree this binary
+// was built from, or ./robots (the path is returned even when no such file exists).
+std::filesystem::path robot_path_named(const std::string& name);
+// The shipped default: robots/superball.json (DESIGN.md's hardware).
 std::filesystem::path default_robot_path();
 // FNV-1a 64-bit of `text`, as 16 lower-case hex digits.
 std::string fnv1a64_hex(const std::string& text);

@@ -4,7 +4,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -123,6 +126,30 @@ TEST_F(PolicyFile, NonFiniteValueIsNamed) {
 
 TEST_F(PolicyFile, MissingFileIsAClearError) {
   EXPECT_THROW(load_policy("/nonexistent/policy.json", robot), PolicyError);
+}
+
+TEST_F(PolicyFile, NamesItsRobotSoNoRobotNeedBeGiven) {
+  const auto dir = std::filesystem::temp_directory_path() / ("policy_robot_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const json& doc) {
+    const auto path = dir / name;
+    std::ofstream(path) << doc.dump();
+    return path;
+  };
+  json doc = good();
+  doc["robot"] = "superball-ntrt2014";
+  EXPECT_EQ(robot_path_for_policy(write("ntrt.json", doc)).filename(), "superball-ntrt2014.json");
+  EXPECT_EQ(load_robot(robot_path_for_policy(dir / "ntrt.json")).name, "superball-ntrt2014");
+  // Unknown robots, paths smuggled in as names and broken files fall back to the
+  // default robot, whose own name check then reports the mismatch.
+  doc["robot"] = "no-such-robot";
+  EXPECT_EQ(robot_path_for_policy(write("unknown.json", doc)), default_robot_path());
+  doc["robot"] = "../robots/superball-ntrt2014";
+  EXPECT_EQ(robot_path_for_policy(write("path.json", doc)), default_robot_path());
+  std::ofstream(dir / "broken.json") << "{";
+  EXPECT_EQ(robot_path_for_policy(dir / "broken.json"), default_robot_path());
+  EXPECT_EQ(robot_path_for_policy(dir / "missing.json"), default_robot_path());
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
