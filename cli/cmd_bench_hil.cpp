@@ -19,6 +19,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/run_cpu.hpp"
+#include "cli/shipped_policy.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
@@ -133,18 +134,6 @@ nlohmann::json RunSampler::report(double dt_s) const {
           {"load_average_end", end_.load_average_1min}};
 }
 
-std::filesystem::path bench_policy(const std::string& given) {
-  if (!given.empty()) return given;
-  const std::filesystem::path name = "policies/superball-t4-n5.json";
-  if (std::filesystem::exists(name)) return name;
-#ifdef TENSEGRITY_SOURCE_DIR
-  if (std::filesystem::exists(std::filesystem::path(TENSEGRITY_SOURCE_DIR) / name)) {
-    return std::filesystem::path(TENSEGRITY_SOURCE_DIR) / name;
-  }
-#endif
-  throw CommandError(2, "no policy: " + name.string() + " not found; give one with --policy FILE");
-}
-
 struct ModeResult {
   hil::HilResult result;
   nlohmann::json cpu;
@@ -152,7 +141,7 @@ struct ModeResult {
 
 ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double duration_s, double dt_s) {
   hil::HilOptions o;
-  o.policy = bench_policy(args.policy);
+  o.policy = shipped_policy_or(args.policy);
   o.endcap_binary = args.endcap;
   o.duration_s = duration_s;
   o.mode = mode;
@@ -232,10 +221,11 @@ void run_bench_hil(const BenchHilArgs& args) {
   // Ctrl-C ends a run in order: the end caps are shut down, the temp dir removed.
   std::signal(SIGINT, on_bench_stop_signal);
   std::signal(SIGTERM, on_bench_stop_signal);
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const std::filesystem::path policy_path = shipped_policy_or(args.policy);
+  const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(policy_path));
   const double dt_s = robot.time_step_s;
   // The in-process reference: same policy, same start, one thread.
-  sim::CoreController reference(robot, sim::load_policy(bench_policy(args.policy), robot));
+  sim::CoreController reference(robot, sim::load_policy(policy_path, robot));
   sim::EpisodeOptions eo;
   eo.duration_s = args.lockstep_s;
   const sim::EpisodeResult ref = sim::run_episode(robot, reference, eo);
@@ -243,7 +233,7 @@ void run_bench_hil(const BenchHilArgs& args) {
   const ModeResult lock = run_mode(args, hil::StepperMode::lockstep, args.lockstep_s, dt_s);
   const ModeResult real = run_mode(args, hil::StepperMode::realtime, args.realtime_s, dt_s);
   const nlohmann::json j = {{"benchmark", "hil"},
-                            {"policy", bench_policy(args.policy).string()},
+                            {"policy", policy_path.string()},
                             {"provision", args.provision},
                             {"lockstep", lockstep_json(lock, ref.distance_m)},
                             {"realtime", realtime_json(real)}};
@@ -288,7 +278,7 @@ void run_bench_hil(const BenchHilArgs& args) {
 void add_bench_hil_command(CLI::App& bench) {
   auto args = std::make_shared<BenchHilArgs>();
   CLI::App* cmd = bench.add_subcommand("hil", "HIL with 12 end caps: lockstep speed-up, real-time late steps, CPU per end cap");
-  cmd->add_option("--policy", args->policy, "Policy file (default: policies/superball-t4-n5.json)")->check(CLI::ExistingFile);
+  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")->check(CLI::ExistingFile);
   cmd->add_option("--lockstep-duration", args->lockstep_s, "Lockstep physics time, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--realtime-duration", args->realtime_s, "Real-time run, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--endcap", args->endcap, "The endcap program");

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "cli/shipped_policy.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "sim/core_controller.hpp"
@@ -49,20 +50,10 @@ void install_stop_handlers() {
   std::signal(SIGTERM, on_stop_signal);
 }
 
-fs::path resolve_policy(const std::string& given) {
-  if (!given.empty()) return given;
-  const fs::path name = "policies/superball-t4-n5.json";
-  if (fs::exists(name)) return name;
-#ifdef TENSEGRITY_SOURCE_DIR
-  if (fs::exists(fs::path(TENSEGRITY_SOURCE_DIR) / name)) return fs::path(TENSEGRITY_SOURCE_DIR) / name;
-#endif
-  throw CommandError(2, "no policy: " + name.string() + " not found; give one with --policy FILE");
-}
-
 hil::HilOptions make_options(const HilArgs& a) {
   hil::HilOptions o;
   o.robot = a.robot;
-  o.policy = resolve_policy(a.policy);
+  o.policy = shipped_policy_or(a.policy);
   o.duration_s = a.duration_s;
   o.mode = a.mode == "realtime" ? hil::StepperMode::realtime : hil::StepperMode::lockstep;
   o.record_csv = a.record;
@@ -106,7 +97,7 @@ void add_hil_command(CLI::App& app) {
   auto args = std::make_shared<HilArgs>();
   CLI::App* cmd = app.add_subcommand("hil", "Run the HIL emulator with 12 end-cap firmware processes");
   cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names)")->check(CLI::ExistingFile);
-  cmd->add_option("--policy", args->policy, "Policy file (default: policies/superball-t4-n5.json)")->check(CLI::ExistingFile);
+  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")->check(CLI::ExistingFile);
   cmd->add_option("--duration", args->duration_s, "Physics time, seconds")->capture_default_str()->check(CLI::Range(0.001, 86400.0));
   cmd->add_option("--mode", args->mode, "lockstep (the emulator owns time) or realtime (1 kHz wall clock)")
       ->capture_default_str()->check(CLI::IsMember({"lockstep", "realtime"}));
