@@ -26,11 +26,11 @@ bin=build/release
 tensegrity="$bin/cli/tensegrity"
 mkdir -p out
 
-policy=policies/superball-t4-n5.json
+policy=policies/superball-ntrt2014-t4-n5.json
 if [[ $evolve -eq 1 ]]; then
   policy=out/evolved.json
   echo "== evolving a policy (t = 4 s, n = 5, historical average, 5000 episodes)"
-  "$tensegrity" evolve --period 4 --complexity 5 --method historical --episodes 5000 --seed 1 \
+  "$tensegrity" evolve --robot robots/superball-ntrt2014.json --period 4 --complexity 5 --method historical --episodes 5000 --seed 1 \
     --checkpoint out/evolve-checkpoint --resume --out "$policy" --log out/evolve-curve.csv
 fi
 

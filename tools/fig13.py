@@ -154,8 +154,8 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--tensegrity", help="the tensegrity program (default: build/release or build/default)")
-    p.add_argument("--policy", help="policy file (default: the HIL's, policies/superball-t4-n5.json)")
-    p.add_argument("--robot", default=os.path.join(ROOT, "robots", "superball.json"), help="robot file (cable owners)")
+    p.add_argument("--policy", help="policy file (default: the HIL's, policies/superball-ntrt2014-t4-n5.json)")
+    p.add_argument("--robot", default=os.path.join(ROOT, "robots", "superball-ntrt2014.json"), help="robot file (cable owners; the policy's)")
     p.add_argument("--duration", type=float, default=60.0, help="seconds of physics per run (paper: 60)")
     p.add_argument("--mode", choices=["lockstep", "realtime"], default="lockstep")
     p.add_argument("--provision", choices=["dds", "local"], default="dds")
@@ -192,7 +192,7 @@ def main():
             print(f"  {failure}: cable {m:2d} (end cap {owner[m]:2d}): {r['distance_m']:7.3f} m ({pct:+6.1f} %, "
                   f"{r['wall_s']:.1f} s wall)", flush=True)
     meta = {"duration_s": args.duration, "mode": args.mode, "provision": args.provision,
-            "provisioner": base["provisioner"], "policy": args.policy or "policies/superball-t4-n5.json"}
+            "provisioner": base["provisioner"], "policy": args.policy or "policies/superball-ntrt2014-t4-n5.json"}
     print(write_outputs(args.out, rows, meta))
     print(plot(args.out, rows, title))
     for failure in failures:
