@@ -208,6 +208,7 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   std::mutex m;
   std::array<double, kEndcapCount> lo{}, hi{};
   std::array<std::uint64_t, kEndcapCount> running_samples{};
+  std::array<std::uint32_t, kEndcapCount> first_seq{}, last_seq{};
   lo.fill(10.0);
   observer_->on_telemetry([&](const msg::Telemetry_& t, std::int64_t) {
     if (t.endcap_id() < 0 || t.endcap_id() >= kEndcapCount || t.mode() != 1) return;
@@ -215,7 +216,8 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
     std::lock_guard lock(m);
     lo[i] = std::min(lo[i], t.commanded_rest_length_m()[0]);
     hi[i] = std::max(hi[i], t.commanded_rest_length_m()[0]);
-    ++running_samples[i];
+    if (running_samples[i]++ == 0) first_seq[i] = t.seq();
+    last_seq[i] = t.seq();
   });
   const bool all_running =
       wait_all([](const EndcapStatus& s) { return s.have_telemetry && s.telemetry.mode() == 1U; }, 10.0);
@@ -229,7 +231,10 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
                                std::to_string(snap[i].telemetry_count) + ", lost " +
                                std::to_string(snap[i].telemetry_gaps) + ", last mode " +
                                std::to_string(unsigned{snap[i].telemetry.mode()}) + ")";
-      EXPECT_GT(running_samples[i], 50U) << "end cap " << e << ": too little telemetry in mode running" << seen;
+      // Sent (by sequence number) is the end cap's doing; received is a best-effort
+      // reader's on a loaded 2-core machine, which may drop many: ask only for some.
+      EXPECT_GT(last_seq[i] - first_seq[i], 50U) << "end cap " << e << ": too little telemetry sent in mode running" << seen;
+      EXPECT_GE(running_samples[i], 5U) << "end cap " << e << ": too little telemetry received in mode running" << seen;
       // 0.2 m/s for 2 s toward a table 0.6..0.96 m: well over 1 cm.
       EXPECT_GT(hi[i] - lo[i], 0.01) << "end cap " << e << ": commanded rest length of motor 0 did not move" << seen;
     }
