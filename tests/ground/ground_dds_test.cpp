@@ -7,13 +7,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <regex>
 #include <set>
+#include <vector>
 
 #include "firmware/comms/reasons.hpp"
 #include "ground/command.hpp"
@@ -244,35 +247,57 @@ TEST_F(GroundDds, StartAtHostTimePutsAllTwelveInPhase) {
 
 TEST_F(GroundDds, TelemetryArrivesAtTheConfiguredRate) {
   constexpr int kDomain = 154;
-  start_nodes(kDomain, {"--telemetry-hz", "100", "--quiet"});
+  // 40 Hz, not the 100 Hz default: the pacing below must come from the option.
+  constexpr double kPeriodMs = 25.0;
+  start_nodes(kDomain, {"--telemetry-hz", "40", "--quiet"});
   Station& s = station(kDomain);
   ASSERT_TRUE(s.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));
+  // Intervals between consecutive samples (seq + 1), on the end cap's own loop clock.
+  std::mutex m;
+  std::array<std::vector<double>, kEndcapCount> intervals_ms;
+  std::array<std::pair<std::uint32_t, std::int64_t>, kEndcapCount> previous{};
+  s.on_telemetry([&](const msg::Telemetry_& t, std::int64_t) {
+    if (t.endcap_id() < 0 || t.endcap_id() >= kEndcapCount) return;
+    const auto i = static_cast<std::size_t>(t.endcap_id());
+    std::lock_guard lock(m);
+    if (previous[i].second != 0 && t.seq() == previous[i].first + 1) {
+      intervals_ms[i].push_back(static_cast<double>(t.loop_time_ns() - previous[i].second) / 1e6);
+    }
+    previous[i] = {t.seq(), t.loop_time_ns()};
+  });
   std::this_thread::sleep_for(std::chrono::seconds(1));
   const auto a = s.snapshot();
   const std::int64_t t0 = Station::now_ns();
   std::this_thread::sleep_for(std::chrono::seconds(4));
   const auto b = s.snapshot();
+  s.on_telemetry(nullptr);
   const double dt = static_cast<double>(Station::now_ns() - t0) / 1e9;
-  double total = 0.0;
+  double total = 0.0, total_sent = 0.0;
   std::uint64_t gaps = 0;
+  std::lock_guard lock(m);
   for (int e = 0; e < kEndcapCount; ++e) {
-    const double rate = static_cast<double>(b[e].telemetry_count - a[e].telemetry_count) / dt;
-    total += rate;
-    gaps += b[e].telemetry_gaps - a[e].telemetry_gaps;
-    // What the end cap sent, by its own clock and sequence numbers: a best-effort
-    // reader on a loaded 2-core CI machine drops and lags samples (CI once received
-    // 61-66 of 100 Hz with every test running), which says nothing about the
-    // configured rate. The received rate is the MEASURE line, not an assertion.
-    const double sent_s = static_cast<double>(b[e].telemetry.loop_time_ns() - a[e].telemetry.loop_time_ns()) / 1e9;
+    const auto i = static_cast<std::size_t>(e);
+    total += static_cast<double>(b[i].telemetry_count - a[i].telemetry_count) / dt;
+    gaps += b[i].telemetry_gaps - a[i].telemetry_gaps;
+    const double sent_s = static_cast<double>(b[i].telemetry.loop_time_ns() - a[i].telemetry.loop_time_ns()) / 1e9;
     ASSERT_GT(sent_s, 1.0) << "end cap " << e << " stopped sending";
-    const double sent_hz = static_cast<double>(b[e].telemetry.seq() - a[e].telemetry.seq()) / sent_s;
-    // The configured 100 Hz, not the loop's 1 kHz nor a stall.
-    EXPECT_GT(sent_hz, 80.0) << "end cap " << e;
-    EXPECT_LT(sent_hz, 110.0) << "end cap " << e;
-    EXPECT_GT(rate, 0.0) << "end cap " << e << ": nothing received";
+    const double sent_hz = static_cast<double>(b[i].telemetry.seq() - a[i].telemetry.seq()) / sent_s;
+    total_sent += sent_hz;
+    // Rates are timing, and CI's 2 shared cores starve the 12 nodes (they once sent
+    // only 53-58 of 100 Hz: a node skips samples it is late for rather than burst),
+    // so the assertions are about pacing, which load cannot fake: the node never
+    // sends faster than configured, and the typical gap on its own clock is the
+    // configured period. The rates are the MEASURE line.
+    EXPECT_LT(sent_hz, 1000.0 / kPeriodMs * 1.1) << "end cap " << e;
+    EXPECT_GT(sent_hz, 1.0) << "end cap " << e << ": (almost) stalled";
+    auto& v = intervals_ms[i];
+    ASSERT_GE(v.size(), 10U) << "end cap " << e << ": too few consecutive samples received";
+    std::sort(v.begin(), v.end());
+    const double p25 = v[v.size() / 4];
+    EXPECT_NEAR(p25, kPeriodMs, 0.3 * kPeriodMs) << "end cap " << e << ": typical sample gap, ms";
   }
-  std::printf("MEASURE telemetry total=%.1f samples/s (%.1f kB/s payload ~%zu B) lost=%llu\n", total,
-              total * 220 / 1e3, std::size_t{220}, static_cast<unsigned long long>(gaps));
+  std::printf("MEASURE telemetry at 40 Hz: sent %.1f samples/s, received %.1f (%.1f kB/s payload ~%zu B) lost=%llu\n",
+              total_sent, total, total * 220 / 1e3, std::size_t{220}, static_cast<unsigned long long>(gaps));
 }
 
 TEST_F(GroundDds, KillingTheHostLeavesEndcapsBehavingAsConfigured) {
