@@ -46,12 +46,8 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
   const int threads = args.threads > 0 ? args.threads : (hw == 0 ? 1 : static_cast<int>(hw));
   sim::evolve::EvolveConfig config;
   config.episodes = args.episodes;
-  config.cables = robot.cable_count();
-  config.min_rest_length_m = robot.motor.min_rest_length_m;
-  config.max_rest_length_m = robot.motor.max_rest_length_m;
   config.duration_s = args.duration_s;
-  config.robot_name = robot.name;
-  config.robot_hash = robot.hash;
+  sim::evolve::set_robot(config, robot);
   // The settled start is computed once per process; keep it out of the timing.
   (void)sim::settled_state(robot, robot.time_step_s);
 

@@ -88,14 +88,10 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   config.sigma_m = args.sigma_m;
   config.seed = args.seed;
   config.episodes = args.episodes;
-  config.cables = robot.cable_count();
   config.complexity = args.complexity;
-  config.min_rest_length_m = robot.motor.min_rest_length_m;
-  config.max_rest_length_m = robot.motor.max_rest_length_m;
   config.period_s = args.period_s;
   config.duration_s = args.duration_s;
-  config.robot_name = robot.name;
-  config.robot_hash = robot.hash;
+  sim::evolve::set_robot(config, robot);
   try {
     sim::evolve::validate(config);
   } catch (const sim::evolve::ConfigError& e) {

@@ -28,6 +28,14 @@ TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, do
   return TeamResult{result.feasible ? result.distance_m : 0.0, result.feasible};
 }
 
+void set_robot(EvolveConfig& config, const Robot& robot) {
+  config.cables = robot.cable_count();
+  config.min_rest_length_m = robot.motor.min_rest_length_m;
+  config.max_rest_length_m = robot.motor.max_rest_length_m;
+  config.robot_name = robot.name;
+  config.robot_hash = robot.hash;
+}
+
 TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config) {
   if (robot.cable_count() != config.cables) {
     throw ConfigError("robot has " + std::to_string(robot.cable_count()) + " cables, config " +

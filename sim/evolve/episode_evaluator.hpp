@@ -17,6 +17,10 @@ namespace tensegrity::sim::evolve {
 // The team as a policy file for `robot` (owners from the robot; provenance empty).
 Policy team_policy(const Robot& robot, double period_s, int complexity, const Team& team);
 
+// Fills what the config takes from the robot: cable count, rest-length limits, name
+// and hash (checkpoints and MPI ranks compare them).
+void set_robot(EvolveConfig& config, const Robot& robot);
+
 // One episode of `duration_s` from the settled start. Thread-safe.
 TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, const Team& team);
 

@@ -58,11 +58,7 @@ TEST(Determinism, PhysicsIsTheSameOnOneTwoAndThreeThreads) {
   config.period_s = 1.0;
   config.duration_s = 2.0;
   config.seed = 5;
-  config.cables = robot.cable_count();
-  config.min_rest_length_m = robot.motor.min_rest_length_m;
-  config.max_rest_length_m = robot.motor.max_rest_length_m;
-  config.robot_name = robot.name;
-  config.robot_hash = robot.hash;
+  set_robot(config, robot);
   std::vector<Outcome> outcomes;
   for (int threads : {1, 2, 3}) {
     auto evaluator = make_episode_evaluator(robot, config, threads);

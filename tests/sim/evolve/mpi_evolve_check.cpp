@@ -121,11 +121,7 @@ void physics(MpiSession& session) {
   config.period_s = 1.0;
   config.duration_s = 1.0;
   config.seed = 5;
-  config.cables = robot.cable_count();
-  config.min_rest_length_m = robot.motor.min_rest_length_m;
-  config.max_rest_length_m = robot.motor.max_rest_length_m;
-  config.robot_name = robot.name;
-  config.robot_hash = robot.hash;
+  set_robot(config, robot);
   auto threaded = make_episode_evaluator(robot, config, 2);
   const Outcome reference = run(config, *threaded);
   std::FILE* f = std::fopen(path.c_str(), "rb");

@@ -108,11 +108,7 @@ EvolveConfig physics_config(const Robot& robot) {
   c.complexity = 3;
   c.period_s = 1.0;
   c.duration_s = 1.0;
-  c.cables = robot.cable_count();
-  c.min_rest_length_m = robot.motor.min_rest_length_m;
-  c.max_rest_length_m = robot.motor.max_rest_length_m;
-  c.robot_name = robot.name;
-  c.robot_hash = robot.hash;
+  set_robot(c, robot);
   return c;
 }
 
