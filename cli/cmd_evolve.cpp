@@ -202,7 +202,8 @@ void add_evolve_command(CLI::App& app) {
                   "depend on it")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--checkpoint", args->checkpoint, "Directory for a checkpoint after every generation");
-  cmd->add_flag("--resume", args->resume, "Continue the run checkpointed in --checkpoint");
+  cmd->add_flag("--resume", args->resume,
+                "Continue the run checkpointed in --checkpoint (a larger --episodes extends a finished run)");
   // Not checked by the parser: with --mpi only rank 0 reads it, the other machines need no copy.
   cmd->add_option("--robot", args->robot, "Robot description");
   cmd->add_option("--population", args->population, "Members per cable population")->capture_default_str()->check(CLI::Range(2, 100000));

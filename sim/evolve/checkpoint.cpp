@@ -151,7 +151,13 @@ std::optional<LoadedCheckpoint> load_checkpoint(const std::filesystem::path& dir
       problems.emplace_back(e.what());
       continue;
     }
-    const auto diffs = config_differences(cp.config, expected);
+    // A larger episode budget continues the run: the budget only says when to stop,
+    // so the result equals an uninterrupted run with the larger budget, as long as
+    // no generation so far was cut short by the old budget.
+    EvolveConfig as_saved = expected;
+    const bool whole_generations = cp.state.episodes == std::int64_t{cp.state.generation} * cp.config.teams;
+    if (expected.episodes > cp.config.episodes && whole_generations) as_saved.episodes = cp.config.episodes;
+    const auto diffs = config_differences(cp.config, as_saved);
     if (!diffs.empty()) {
       std::string message = path.string() + ": made with another config; refusing to resume (checkpoint -> requested):";
       for (const auto& d : diffs) message += "\n  " + d;

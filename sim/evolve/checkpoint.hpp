@@ -44,7 +44,9 @@ struct LoadedCheckpoint {
 };
 // The newest usable checkpoint in `dir`; nullopt when there is none. Throws
 // CheckpointError when no file in it can be read, or when the one read was made with
-// a config other than `expected` (the error lists the differing fields).
+// a config other than `expected` (the error lists the differing fields). A larger
+// `episodes` than the checkpoint's is not a difference: the run goes on to the new
+// budget (unless its last generation was cut short by the old one).
 std::optional<LoadedCheckpoint> load_checkpoint(const std::filesystem::path& dir, const EvolveConfig& expected);
 
 }  // namespace tensegrity::sim::evolve

@@ -227,6 +227,47 @@ TEST_F(Checkpoints, ResumingWithAnotherConfigIsRefused) {
   }
 }
 
+TEST_F(Checkpoints, ALargerBudgetContinuesAFinishedRunAsIfItHadBeenOneRun) {
+  const Final expected = straight(root_ / "a");  // 600 episodes
+  FunctionEvaluator evaluator(testing::synthetic_score);
+  DriverOptions options;
+  options.checkpoint_dir = root_ / "b" / "ckpt";
+  options.curve_csv = root_ / "b" / "curve.csv";
+  EvolveConfig short_run = config();
+  short_run.episodes = 300;
+  EXPECT_TRUE(drive(short_run, evaluator, options).evolution.done());
+  const Final got = resume(root_ / "b");
+  EXPECT_EQ(got.state, expected.state);
+  EXPECT_EQ(got.curve, expected.curve);
+}
+
+TEST_F(Checkpoints, ALargerBudgetIsRefusedWhenTheOldOneCutAGenerationShort) {
+  FunctionEvaluator evaluator(testing::synthetic_score);
+  DriverOptions options;
+  options.checkpoint_dir = root_ / "b" / "ckpt";
+  EvolveConfig short_run = config();
+  short_run.episodes = 320;  // 6 generations of 50, then one of 20
+  (void)drive(short_run, evaluator, options);
+  options.resume = true;
+  try {
+    (void)drive(config(), evaluator, options);
+    FAIL() << "expected CheckpointError";
+  } catch (const CheckpointError& e) {
+    EXPECT_NE(std::string(e.what()).find("episodes: 320 -> 600"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(Checkpoints, ASmallerBudgetIsRefused) {
+  run_generations(root_ / "b", 2);
+  EvolveConfig other = config();
+  other.episodes = 500;
+  FunctionEvaluator evaluator(testing::synthetic_score);
+  DriverOptions options;
+  options.checkpoint_dir = root_ / "b" / "ckpt";
+  options.resume = true;
+  EXPECT_THROW((void)drive(other, evaluator, options), CheckpointError);
+}
+
 TEST_F(Checkpoints, AnExistingCheckpointIsNotOverwrittenWithoutResume) {
   run_generations(root_ / "b", 1);
   FunctionEvaluator evaluator(testing::synthetic_score);
