@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <thread>
 #include <unistd.h>
@@ -23,6 +24,7 @@
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
+#include "hil/timer_probe.hpp"
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
 #include "sim/policy.hpp"
@@ -37,6 +39,7 @@ struct BenchHilArgs {
   std::string policy;
   double lockstep_s = 10.0;
   double realtime_s = 10.0;
+  double probe_s = 10.0;
   std::string endcap;
   std::string provision = hil::to_string(hil::default_provision());
   bool json = false;
@@ -114,6 +117,7 @@ nlohmann::json RunSampler::report(double dt_s) const {
   const double per_sim = sim > 0 ? (emulator + endcaps) / sim : 0.0;
   const long cpus = ::sysconf(_SC_NPROCESSORS_ONLN);
   const double mean_endcap = counted ? endcaps / counted : 0.0;
+  const double steal_s = start_.steal_ns >= 0 && end_.steal_ns >= 0 ? s_of(end_.steal_ns - start_.steal_ns) : -1.0;
   return {{"sim_s", sim},
           {"wall_s", wall},
           {"speed_up", wall > 0 ? sim / wall : 0.0},
@@ -131,7 +135,9 @@ nlohmann::json RunSampler::report(double dt_s) const {
           {"cpus", cpus},
           {"implied_speed_up_idle", per_sim > 0 ? static_cast<double>(cpus) / per_sim : 0.0},
           {"load_average_start", start_.load_average_1min},
-          {"load_average_end", end_.load_average_1min}};
+          {"load_average_end", end_.load_average_1min},
+          {"steal_s", steal_s},
+          {"steal_cpu_fraction", wall > 0 && cpus > 0 ? steal_s / (wall * static_cast<double>(cpus)) : 0.0}};
 }
 
 struct ModeResult {
@@ -207,14 +213,27 @@ nlohmann::json realtime_json(const ModeResult& m) {
           {"endcap_core_fraction_max", m.cpu["endcap_core_fraction_max"]}};
 }
 
+nlohmann::json platform_json(const hil::TimerProbeResult& p) {
+  const hil::LatenessSummary& l = p.lateness;
+  return {{"what", "a thread that only paces like the real-time stepper (same priority, sleep then spin, "
+                   "absolute 1 ms deadlines), before the runs: the kernel's and hypervisor's share of lateness"},
+          {"sched_fifo", p.sched_fifo},
+          {"steps", l.steps},
+          {"late_steps", l.late_steps},
+          {"late_rate", l.steps > 0 ? static_cast<double>(l.late_steps) / static_cast<double>(l.steps) : 0.0},
+          {"late_episodes", l.late_episodes},
+          {"lateness_p99_s", 1e-9 * static_cast<double>(l.p99_ns)},
+          {"max_lateness_s", 1e-9 * static_cast<double>(l.max_ns)}};
+}
+
 void print_cpu(const nlohmann::json& c) {
   std::printf("            CPU per simulated second %.3f s (emulator %.3f, stepper thread %.3f; end caps %.3f, %.4f each)\n",
               c["cpu_s_per_sim_s"].get<double>(), c["emulator_cpu_s_per_sim_s"].get<double>(),
               c["stepper_thread_cpu_s"].get<double>() / c["sim_s"].get<double>(),
               c["endcaps_cpu_s_per_sim_s"].get<double>(),
               c["endcap_cpu_mean_s"].get<double>() / c["sim_s"].get<double>());
-  std::printf("            load average %.2f -> %.2f over the run\n", c["load_average_start"].get<double>(),
-              c["load_average_end"].get<double>());
+  std::printf("            load average %.2f -> %.2f over the run; steal %.2f s (hypervisor)\n",
+              c["load_average_start"].get<double>(), c["load_average_end"].get<double>(), c["steal_s"].get<double>());
 }
 
 void run_bench_hil(const BenchHilArgs& args) {
@@ -230,13 +249,17 @@ void run_bench_hil(const BenchHilArgs& args) {
   eo.duration_s = args.lockstep_s;
   const sim::EpisodeResult ref = sim::run_episode(robot, reference, eo);
 
+  // First, with nothing of ours running: what the kernel and hypervisor cost a 1 kHz loop.
+  std::optional<hil::TimerProbeResult> probe;
+  if (args.probe_s > 0) probe = hil::probe_timer_latency(args.probe_s);
   const ModeResult lock = run_mode(args, hil::StepperMode::lockstep, args.lockstep_s, dt_s);
   const ModeResult real = run_mode(args, hil::StepperMode::realtime, args.realtime_s, dt_s);
   const nlohmann::json j = {{"benchmark", "hil"},
                             {"policy", policy_path.string()},
                             {"provision", args.provision},
                             {"lockstep", lockstep_json(lock, ref.distance_m)},
-                            {"realtime", realtime_json(real)}};
+                            {"realtime", realtime_json(real)},
+                            {"platform", probe ? platform_json(*probe) : nlohmann::json(nullptr)}};
   if (args.json) {
     std::printf("%s\n", j.dump(2).c_str());
     return;
@@ -271,6 +294,13 @@ void run_bench_hil(const BenchHilArgs& args) {
               100.0 * rc["endcap_core_fraction_mean"].get<double>(), 100.0 * rc["endcap_core_fraction_max"].get<double>(),
               100.0 * rc["emulator_process_cpu_s"].get<double>() / rc["wall_s"].get<double>());
   print_cpu(rc);
+  if (const auto& p = j["platform"]; !p.is_null()) {
+    std::printf("  platform  a bare 1 kHz pacing thread (%s), %lld steps before the runs: %lld late (%.4f%%) in %lld "
+                "episode(s), worst %.3f ms\n",
+                p["sched_fifo"].get<bool>() ? "SCHED_FIFO" : "normal priority", p["steps"].get<long long>(),
+                p["late_steps"].get<long long>(), 100.0 * p["late_rate"].get<double>(),
+                p["late_episodes"].get<long long>(), 1e3 * p["max_lateness_s"].get<double>());
+  }
 }
 
 }  // namespace
@@ -281,6 +311,9 @@ void add_bench_hil_command(CLI::App& bench) {
   cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")->check(CLI::ExistingFile);
   cmd->add_option("--lockstep-duration", args->lockstep_s, "Lockstep physics time, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--realtime-duration", args->realtime_s, "Real-time run, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--probe-duration", args->probe_s,
+                  "Before the runs, a bare pacing thread for this long: the platform's late rate (0: skip)")
+      ->capture_default_str()->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--endcap", args->endcap, "The endcap program");
   cmd->add_option("--provision", args->provision, "dds or local (see `tensegrity hil --help`)")
       ->capture_default_str()->check(CLI::IsMember({"dds", "local"}));

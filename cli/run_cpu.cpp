@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "cli/run_cpu.hpp"
 
+#include <unistd.h>
+
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -24,12 +26,26 @@ double load_average_1min() {
   return load;
 }
 
+std::int64_t steal_ns() {
+  // "cpu  user nice system idle iowait irq softirq steal ..." in USER_HZ ticks.
+  std::ifstream in("/proc/stat");
+  std::string label;
+  long long fields[8] = {};
+  if (!(in >> label) || label != "cpu") return -1;
+  for (long long& f : fields) {
+    if (!(in >> f)) return -1;
+  }
+  const long hz = ::sysconf(_SC_CLK_TCK);
+  return hz > 0 ? fields[7] * (1'000'000'000LL / hz) : -1;
+}
+
 CpuSample sample_self() {
   CpuSample s;
   s.wall_ns = clock_ns(CLOCK_MONOTONIC);
   s.stepper_thread_ns = clock_ns(CLOCK_THREAD_CPUTIME_ID);
   s.emulator_process_ns = clock_ns(CLOCK_PROCESS_CPUTIME_ID);
   s.load_average_1min = load_average_1min();
+  s.steal_ns = steal_ns();
   return s;
 }
 

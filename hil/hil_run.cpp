@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "hil/hil_run.hpp"
 
-#include <pthread.h>
-#include <sched.h>
-
 #include <algorithm>
 #include <cmath>
 #include <csignal>
@@ -15,6 +12,7 @@
 #include "hil/hil_error.hpp"
 #include "hil/process_launcher.hpp"
 #include "hil/provisioner.hpp"
+#include "hil/realtime_priority.hpp"
 #include "hil/start_handshake.hpp"
 #ifdef TENSEGRITY_HIL_DDS
 #include "hil/dds_provisioner.hpp"
@@ -25,33 +23,6 @@
 namespace tensegrity::hil {
 
 namespace {
-
-// The stepper owns time, so it must not be preempted by the end caps it wakes:
-// their loop threads run SCHED_FIFO 80 where allowed (the endcap program asks for
-// it), and each datagram of a tick's batch would otherwise switch to the woken end
-// cap before the next one is sent (measured: 0.77 ms per tick spent in the send
-// instead of about 0.1 ms). One priority above theirs, for the run only.
-class ScopedRealtimePriority {
- public:
-  ScopedRealtimePriority() {
-    saved_policy_ = pthread_getschedparam(pthread_self(), &saved_policy_value_, &saved_param_) == 0;
-    sched_param p{};
-    p.sched_priority = 90;
-    active_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p) == 0;
-  }
-  ~ScopedRealtimePriority() {
-    if (active_ && saved_policy_) pthread_setschedparam(pthread_self(), saved_policy_value_, &saved_param_);
-  }
-  ScopedRealtimePriority(const ScopedRealtimePriority&) = delete;
-  ScopedRealtimePriority& operator=(const ScopedRealtimePriority&) = delete;
-  bool active() const { return active_; }
-
- private:
-  bool saved_policy_ = false;
-  int saved_policy_value_ = SCHED_OTHER;
-  sched_param saved_param_{};
-  bool active_ = false;
-};
 
 template <typename T>
 T stat_or(const nlohmann::json& j, const char* key, T fallback) {

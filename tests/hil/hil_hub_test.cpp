@@ -13,6 +13,7 @@
 #include "hil/answer_nap.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/lateness.hpp"
+#include "hil/timer_probe.hpp"
 #include "hil/udp_hub.hpp"
 
 namespace tensegrity::hil {
@@ -164,6 +165,18 @@ TEST(Lateness, CountsLateStepsEpisodesAndMisses) {
   EXPECT_EQ(r.max_ns, 2'200'000);
   EXPECT_EQ(r.p50_ns, 30'000) << "upper edge of the 10 us bucket";
   EXPECT_GE(r.p999_ns, 1'250'000);
+}
+
+TEST(TimerProbe, PacesEveryDeadlineAndNeverReturnsEarly) {
+  const std::int64_t t0 = monotonic_ns();
+  const TimerProbeResult r = probe_timer_latency(0.05, 1'000'000, 50'000);
+  const std::int64_t elapsed = monotonic_ns() - t0;
+  EXPECT_EQ(r.lateness.steps, 50);
+  // Absolute deadlines from one period after the start: 50 of them end after 50 ms.
+  EXPECT_GE(elapsed, 50'000'000);
+  EXPECT_LE(r.lateness.late_steps, r.lateness.steps);
+  EXPECT_LE(r.lateness.late_episodes, r.lateness.late_steps);
+  EXPECT_GE(r.lateness.max_ns, 0) << "the spin never ends before the deadline";
 }
 
 TEST(AnswerNap, FollowsTheUsualLatencyAndShrugsOffOneSlowTick) {
