@@ -11,7 +11,10 @@ bool LatenessStats::add(std::int64_t lateness_ns) noexcept {
   const bool late = ns > late_after_ns_;
   if (late) {
     ++late_;
-    if (!previous_late_) ++episodes_;
+    if (!previous_late_) {
+      ++episodes_;
+      stalled_ns_ += ns;  // the first step of an episode is as late as the stall was long
+    }
   }
   previous_late_ = late;
   return late;
@@ -28,6 +31,7 @@ LatenessSummary LatenessStats::summary() const noexcept {
   s.p99_ns = histogram_.quantile_ns(0.99);
   s.p999_ns = histogram_.quantile_ns(0.999);
   s.max_ns = histogram_.max_ns();
+  s.stalled_ns = stalled_ns_;
   return s;
 }
 

@@ -21,6 +21,9 @@ struct LatenessSummary {
   std::int64_t missed_steps = 0;   // began a whole period or more after the deadline
   std::int64_t late_after_ns = 0;
   std::int64_t p50_ns = 0, p99_ns = 0, p999_ns = 0, max_ns = 0;
+  // Sum over episodes of the first late step's lateness: how long the stepper was
+  // kept from running, to set beside the hypervisor's steal time over the run.
+  std::int64_t stalled_ns = 0;
 };
 
 class LatenessStats {
@@ -36,7 +39,7 @@ class LatenessStats {
   std::int64_t period_ns_;
   std::int64_t late_after_ns_;
   core::FixedHistogram<10'000, 2'000> histogram_;  // 10 us buckets to 20 ms
-  std::int64_t late_ = 0, episodes_ = 0, missed_ = 0;
+  std::int64_t late_ = 0, episodes_ = 0, missed_ = 0, stalled_ns_ = 0;
   bool previous_late_ = false;
 };
 

@@ -163,6 +163,7 @@ TEST(Lateness, CountsLateStepsEpisodesAndMisses) {
   EXPECT_EQ(r.late_episodes, 2);
   EXPECT_EQ(r.missed_steps, 2);
   EXPECT_EQ(r.max_ns, 2'200'000);
+  EXPECT_EQ(r.stalled_ns, 2'200'000 + 600'000) << "each episode counts its first step";
   EXPECT_EQ(r.p50_ns, 30'000) << "upper edge of the 10 us bucket";
   EXPECT_GE(r.p999_ns, 1'250'000);
 }
