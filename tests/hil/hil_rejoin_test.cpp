@@ -24,6 +24,7 @@ class HilRejoin : public ::testing::TestWithParam<RejoinCase> {};
 
 TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
   const RejoinCase c = GetParam();
+  if (c.mode == StepperMode::realtime) TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
   // Real time: killed late enough that the start command in the link's history is
   // older than the end caps' replay limit (5 s): the provisioner itself has to
   // start the new program, at the run's start time.

@@ -172,6 +172,7 @@ TEST(HilRun, CorruptedFramesAreCountedAndIgnored) {
 }
 
 TEST(HilRun, RealTimeModePacesToTheWallClock) {
+  TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
   HilOptions o = options(3.0);
   o.mode = StepperMode::realtime;
   const HilResult r = run_hil(o);
