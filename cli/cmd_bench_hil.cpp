@@ -137,7 +137,7 @@ nlohmann::json RunSampler::report(double dt_s) const {
           {"load_average_start", start_.load_average_1min},
           {"load_average_end", end_.load_average_1min},
           {"steal_s", steal_s},
-          {"steal_cpu_fraction", wall > 0 && cpus > 0 ? steal_s / (wall * static_cast<double>(cpus)) : 0.0}};
+          {"steal_cpu_fraction", steal_s >= 0 && wall > 0 && cpus > 0 ? steal_s / (wall * static_cast<double>(cpus)) : -1.0}};
 }
 
 struct ModeResult {
