@@ -5,8 +5,9 @@
 // each in the temp directory: the kernel drops the lock when the process ends,
 // however it ends, so a crashed run never keeps its domain. Their RTPS ports
 // (7400 + 250 x domain + ..., 61150 and up) lie above Linux's ephemeral range
-// (32768..60999), where the HIL picks its CAN-over-UDP ports: a lower domain's
-// participants once took a port the launcher had just picked for an end cap's bus.
+// (32768..60999) and the 2048 ports below it, where the HIL picks its CAN-over-UDP
+// ports (hil/process_launcher): a lower domain's participants once took a port the
+// launcher had just picked for an end cap's bus.
 #pragma once
 
 #include <filesystem>

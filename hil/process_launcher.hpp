@@ -99,7 +99,9 @@ class ProcessLauncher final : public EndcapProcesses {
   bool shut_down_ = false;
 };
 
-// Free UDP ports on 127.0.0.1 (bound to port 0 together, then released).
+// Free UDP ports on 127.0.0.1 for the end caps' buses, from the kLauncherPortSpan
+// ports just below the kernel's ephemeral range (bound together, then released).
+inline constexpr int kLauncherPortSpan = 2048;
 std::vector<std::uint16_t> free_udp_ports(int count);
 // The `endcap` program: $TENSEGRITY_ENDCAP, else the one built with this tree.
 std::filesystem::path default_endcap_binary();

@@ -5,14 +5,18 @@
 // real-time lateness count and the lockstep answer nap.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "firmware/drivers/cob_id.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
 #include "hil/answer_nap.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/lateness.hpp"
+#include "hil/process_launcher.hpp"
 #include "hil/timer_probe.hpp"
 #include "hil/udp_hub.hpp"
 
@@ -166,6 +170,26 @@ TEST(Lateness, CountsLateStepsEpisodesAndMisses) {
   EXPECT_EQ(r.stalled_ns, 2'200'000 + 600'000) << "each episode counts its first step";
   EXPECT_EQ(r.p50_ns, 30'000) << "upper edge of the 10 us bucket";
   EXPECT_GE(r.p999_ns, 1'250'000);
+}
+
+TEST(LauncherPorts, DistinctFreeAndBelowTheEphemeralRange) {
+  std::ifstream range("/proc/sys/net/ipv4/ip_local_port_range");
+  int ephemeral_low = 32768;
+  range >> ephemeral_low;
+  const std::vector<std::uint16_t> ports = free_udp_ports(12);
+  ASSERT_EQ(ports.size(), 12U);
+  EXPECT_EQ(std::set<std::uint16_t>(ports.begin(), ports.end()).size(), 12U);
+  for (const std::uint16_t p : ports) {
+    EXPECT_LT(p, ephemeral_low) << "a port there can be handed to any socket binding port 0";
+    EXPECT_GE(p, ephemeral_low - kLauncherPortSpan);
+  }
+  // Released: an end cap can bind every one of them.
+  std::vector<std::unique_ptr<fw::UdpCanBus>> buses;
+  for (const std::uint16_t p : ports) {
+    std::string error;
+    buses.push_back(fw::UdpCanBus::open({fw::UdpEndpoint{"127.0.0.1", 9}, fw::UdpEndpoint{"127.0.0.1", p}, false}, error));
+    EXPECT_NE(buses.back(), nullptr) << p << ": " << error;
+  }
 }
 
 TEST(TimerProbe, PacesEveryDeadlineAndNeverReturnsEarly) {
