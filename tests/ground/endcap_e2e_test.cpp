@@ -6,9 +6,6 @@
 // observer Station in this process (no heartbeat of its own) watches telemetry
 // and measures the upload latency to the 12 real end caps.
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -21,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "ground/upload.hpp"
+#include "hil/process_launcher.hpp"
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 #include "tests/ground/subprocess.hpp"
@@ -33,31 +31,6 @@ using json = nlohmann::json;
 using test::Subprocess;
 
 constexpr int kDomain = 157;  // unique per DDS test: ctest runs tests in parallel
-
-// A UDP port free right now on loopback, for a CAN-over-UDP bus (closed again
-// before the bus opens it). Never one that a DDS participant of any domain could
-// take meanwhile: RTPS puts domain d's ports at 7400 + 250 d + 0..1 (multicast)
-// and + 10 + 2 p, + 11 + 2 p (participant p), and the end caps start while later
-// ports are still being picked.
-std::uint16_t free_udp_port() {
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    if (fd < 0) return 0;
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t len = sizeof a;
-    std::uint16_t port = 0;
-    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-        ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
-      port = ntohs(a.sin_port);
-    }
-    ::close(fd);
-    const bool rtps_like = port >= 7400 && (port - 7400) % 250 <= 120;  // up to ~55 participants
-    if (port != 0 && !rtps_like) return port;
-  }
-  return 0;
-}
 
 std::string read(const fs::path& file) {
   std::ifstream in(file);
@@ -97,9 +70,11 @@ class RealEndcaps : public ::testing::Test {
 
   void start_endcap(int e) {
     const std::string tag = std::to_string(e);
-    const std::uint16_t endcap_port = free_udp_port();
-    const std::uint16_t device_port = free_udp_port();
-    ASSERT_TRUE(endcap_port != 0 && device_port != 0 && endcap_port != device_port);
+    // The HIL launcher's ports: below the ephemeral range, so that no socket binding
+    // port 0 (a DDS participant's sender) takes one before the programs bind them.
+    const std::vector<std::uint16_t> ports = hil::free_udp_ports(2);
+    const std::uint16_t endcap_port = ports[0];
+    const std::uint16_t device_port = ports[1];
     const json config = {
         {"format", "tensegrity-endcap/1"},
         {"bus", "udp:127.0.0.1:" + std::to_string(device_port) + ",bind=127.0.0.1:" + std::to_string(endcap_port)},
