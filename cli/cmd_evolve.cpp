@@ -37,6 +37,8 @@ struct EvolveArgs {
   int teams = 50;
   int replace = 5;
   double sigma_m = 0.05;
+  double sigma_final_m = -1.0;  // not given: sigma_m
+  std::int64_t anneal_episodes = 0;
   double duration_s = 60.0;
   std::string out;
   std::string log;
@@ -86,6 +88,8 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   config.teams = args.teams;
   config.replace = args.replace;
   config.sigma_m = args.sigma_m;
+  config.sigma_final_m = args.sigma_final_m < 0.0 ? args.sigma_m : args.sigma_final_m;
+  config.anneal_episodes = args.anneal_episodes;
   config.seed = args.seed;
   config.episodes = args.episodes;
   config.complexity = args.complexity;
@@ -144,6 +148,9 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   policy.provenance.episodes = evo.episodes();
   policy.provenance.score_m = final_result.score_m;
   policy.provenance.robot_hash = robot.hash;
+  policy.provenance.sigma_m = config.sigma_m;
+  policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
+  policy.provenance.anneal_episodes = config.anneal_episodes;
   sim::save_policy(args.out, policy);
 
   const std::int64_t episodes_here = evo.episodes() - result.resumed_episodes;
@@ -163,7 +170,8 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
                               {"wall_time_s", wall_s},
                               {"episodes_per_s", rate},
                               {"out", args.out},
-                              {"log", args.log}};
+                              {"log", args.log},
+                              {"config", sim::evolve::config_to_json(config)}};
     if (mpi != nullptr) j["rank_loads"] = mpi->loads();
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -210,6 +218,12 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
   cmd->add_option("--sigma", args->sigma_m, "Mutation step, metres (Gaussian, clamped to the limits)")->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--sigma-final", args->sigma_final_m,
+                  "Mutation step after --anneal-episodes, metres (default: --sigma, no annealing)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--anneal-episodes", args->anneal_episodes,
+                  "Episodes over which the step goes geometrically from --sigma to --sigma-final (0: constant)")
+      ->capture_default_str()->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();

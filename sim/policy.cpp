@@ -112,6 +112,16 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
     if (p.contains("score_m")) policy.provenance.score_m = finite_number(p["score_m"], source, "provenance.score_m");
     policy.provenance.robot_hash = p.value("robot_hash", "");
     policy.provenance.created_by = p.value("created_by", "");
+    if (const auto m = p.find("mutation"); m != p.end()) {
+      if (!m->is_object()) fail(source, "provenance.mutation", "must be an object");
+      Provenance& pr = policy.provenance;
+      pr.sigma_m = finite_number(m->value("sigma_m", json()), source, "provenance.mutation.sigma_m");
+      pr.sigma_final_m = finite_number(m->value("sigma_final_m", json()), source, "provenance.mutation.sigma_final_m");
+      pr.anneal_episodes = integer(m->value("anneal_episodes", json()), source, "provenance.mutation.anneal_episodes");
+      if (pr.sigma_m < 0.0 || pr.sigma_final_m < 0.0 || pr.anneal_episodes < 0) {
+        fail(source, "provenance.mutation", "steps and anneal_episodes must be >= 0");
+      }
+    }
   }
   return policy;
 }
@@ -146,7 +156,7 @@ std::string policy_to_json(const Policy& policy) {
   for (const auto& c : policy.cables) {
     cables.push_back({{"cable", c.cable}, {"owner", c.owner}, {"rest_lengths_m", c.rest_lengths_m}});
   }
-  const json doc = {
+  json doc = {
       {"format", "tensegrity-policy/1"},
       {"robot", policy.robot},
       {"period_s", policy.period_s},
@@ -160,6 +170,11 @@ std::string policy_to_json(const Policy& policy) {
         {"robot_hash", policy.provenance.robot_hash},
         {"created_by", policy.provenance.created_by}}},
   };
+  const Provenance& pr = policy.provenance;
+  if (pr.sigma_m > 0.0) {
+    doc["provenance"]["mutation"] = {
+        {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_episodes", pr.anneal_episodes}};
+  }
   return doc.dump(2) + "\n";
 }
 

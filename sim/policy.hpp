@@ -31,6 +31,11 @@ struct Provenance {
   double score_m = 0.0;
   std::string robot_hash;
   std::string created_by = "tensegrity";
+  // The mutation step the coevolution bred with (its schedule: docs/evolve.md), so that
+  // method + seed + episodes + this reproduce the policy. sigma_m 0: not recorded.
+  double sigma_m = 0.0;
+  double sigma_final_m = 0.0;
+  std::int64_t anneal_episodes = 0;
 };
 
 struct Policy {

@@ -137,6 +137,7 @@ GenerationStats Coevolution::record(const std::vector<TeamPicks>& picks, const s
 void Coevolution::select_and_breed() {
   const auto n = static_cast<std::size_t>(config_.population);
   const auto z = static_cast<std::size_t>(config_.replace);
+  const double sigma_m = mutation_sigma_m(config_, state_.episodes);
   for (auto& population : state_.populations) {
     std::vector<double> f(n);
     for (std::size_t i = 0; i < n; ++i) f[i] = fitness(config_.method, population[i].history);
@@ -152,7 +153,7 @@ void Coevolution::select_and_breed() {
       copy.rest_lengths_m = ranked[i].rest_lengths_m;
       copy.history.clear();
       for (double& v : copy.rest_lengths_m) {
-        v = std::clamp(v + config_.sigma_m * rng_.normal(), config_.min_rest_length_m, config_.max_rest_length_m);
+        v = std::clamp(v + sigma_m * rng_.normal(), config_.min_rest_length_m, config_.max_rest_length_m);
       }
     }
     if (config_.method != FitnessMethod::historical) {

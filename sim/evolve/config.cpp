@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/evolve/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -31,6 +32,11 @@ void validate(const EvolveConfig& c) {
   // The copies come from the survivors: more than half would copy members that die.
   if (c.replace < 1 || c.replace > c.population / 2) fail("replace must be in 1..population/2");
   if (!(c.sigma_m >= 0.0) || !std::isfinite(c.sigma_m)) fail("sigma_m must be finite and >= 0");
+  if (!(c.sigma_final_m >= 0.0) || !std::isfinite(c.sigma_final_m)) fail("sigma_final_m must be finite and >= 0");
+  if (c.anneal_episodes < 0) fail("anneal_episodes must be >= 0");
+  if (c.anneal_episodes > 0 && (c.sigma_m == 0.0) != (c.sigma_final_m == 0.0)) {
+    fail("sigma_m and sigma_final_m must both be > 0 to anneal (the step changes geometrically)");
+  }
   if (c.episodes < 1) fail("episodes must be at least 1");
   if (c.cables < 1) fail("cables must be at least 1");
   if (c.complexity < 1 || c.complexity > static_cast<int>(core::kMaxComplexity)) {
@@ -44,12 +50,23 @@ void validate(const EvolveConfig& c) {
   if (!(c.duration_s > 0.0) || !std::isfinite(c.duration_s)) fail("duration_s must be > 0");
 }
 
+double mutation_sigma_m(const EvolveConfig& c, std::int64_t episodes_done) {
+  if (c.anneal_episodes <= 0 || c.sigma_m == c.sigma_final_m) return c.sigma_m;
+  if (episodes_done >= c.anneal_episodes) return c.sigma_final_m;
+  const double progress = static_cast<double>(std::max<std::int64_t>(episodes_done, 0)) /
+                          static_cast<double>(c.anneal_episodes);
+  return c.sigma_m * std::pow(c.sigma_final_m / c.sigma_m, progress);
+}
+
 nlohmann::json config_to_json(const EvolveConfig& c) {
   return nlohmann::json{{"method", to_string(c.method)},
                         {"population", c.population},
                         {"teams", c.teams},
                         {"replace", c.replace},
                         {"sigma_m", c.sigma_m},
+                        // Without annealing the final step is the step, whatever the field holds.
+                        {"sigma_final_m", c.anneal_episodes > 0 ? c.sigma_final_m : c.sigma_m},
+                        {"anneal_episodes", c.anneal_episodes},
                         {"seed", c.seed},
                         {"episodes", c.episodes},
                         {"cables", c.cables},
@@ -70,6 +87,9 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     c.teams = j.at("teams").get<int>();
     c.replace = j.at("replace").get<int>();
     c.sigma_m = j.at("sigma_m").get<double>();
+    // Checkpoints from before annealing existed mutated with sigma_m throughout.
+    c.sigma_final_m = j.value("sigma_final_m", c.sigma_m);
+    c.anneal_episodes = j.value("anneal_episodes", std::int64_t{0});
     c.seed = j.at("seed").get<std::uint64_t>();
     c.episodes = j.at("episodes").get<std::int64_t>();
     c.cables = j.at("cables").get<int>();

@@ -109,6 +109,28 @@ TEST_F(PolicyFile, EachBadFieldIsNamed) {
   EXPECT_THAT(error_of(doc), HasSubstr("cables[2].cable: no such cable"));
 }
 
+TEST_F(PolicyFile, ProvenanceKeepsTheMutationScheduleAndChecksIt) {
+  EXPECT_FALSE(good()["provenance"].contains("mutation")) << "not recorded: not written";
+  Policy p = parse_policy(good().dump(), robot);
+  p.provenance.sigma_m = 0.05;
+  p.provenance.sigma_final_m = 0.01;
+  p.provenance.anneal_episodes = 2500;
+  const json doc = json::parse(policy_to_json(p));
+  const Policy q = parse_policy(doc.dump(), robot);
+  EXPECT_EQ(q.provenance.sigma_m, 0.05);
+  EXPECT_EQ(q.provenance.sigma_final_m, 0.01);
+  EXPECT_EQ(q.provenance.anneal_episodes, 2500);
+  json bad = doc;
+  bad["provenance"]["mutation"]["anneal_episodes"] = -3;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.mutation: steps and anneal_episodes must be >= 0"));
+  bad = doc;
+  bad["provenance"]["mutation"].erase("sigma_final_m");
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.mutation.sigma_final_m: must be a number"));
+  bad = doc;
+  bad["provenance"]["mutation"] = 0.05;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.mutation: must be an object"));
+}
+
 TEST_F(PolicyFile, NonFiniteValueIsNamed) {
   // JSON has no NaN; an overflowing literal is how a non-finite number arrives.
   std::string text = good().dump();

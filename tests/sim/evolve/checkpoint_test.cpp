@@ -207,6 +207,20 @@ TEST_F(Checkpoints, AnInconsistentCheckpointIsRejected) {
   EXPECT_NO_THROW((void)parse_checkpoint(text, "x"));
 }
 
+// Checkpoints written before the mutation step could anneal have no schedule: they
+// mutated with sigma_m throughout, and they resume that way.
+TEST_F(Checkpoints, OneWithoutAMutationScheduleResumesWithAConstantStep) {
+  run_generations(root_ / "b", 2);
+  nlohmann::json j = nlohmann::json::parse(read(root_ / "b" / "ckpt" / kCheckpointFile));
+  ASSERT_TRUE(j["config"].contains("anneal_episodes"));
+  j["config"].erase("sigma_final_m");
+  j["config"].erase("anneal_episodes");
+  const EvolveConfig old = parse_checkpoint(j.dump(), "x").config;
+  EXPECT_EQ(old.anneal_episodes, 0);
+  EXPECT_DOUBLE_EQ(old.sigma_final_m, old.sigma_m);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(old, 100000), config().sigma_m);
+}
+
 TEST_F(Checkpoints, ResumingWithAnotherConfigIsRefused) {
   run_generations(root_ / "b", 2);
   EvolveConfig other = config();

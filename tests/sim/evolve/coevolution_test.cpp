@@ -180,6 +180,64 @@ TEST(Coevolution, MutationPerturbsCopiesWithinTheLimits) {
   EXPECT_EQ(changed, 12);
 }
 
+TEST(Coevolution, MutationStepAnnealsGeometricallyThenStays) {
+  EvolveConfig c = small_config(FitnessMethod::historical, 0.05);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 0), 0.05);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 1'000'000), 0.05) << "anneal_episodes 0: constant";
+  c.sigma_final_m = 0.01;
+  c.anneal_episodes = 2500;
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 0), 0.05);
+  EXPECT_NEAR(mutation_sigma_m(c, 1250), std::sqrt(0.05 * 0.01), 1e-15) << "halfway: the geometric mean";
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 2500), 0.01);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 9000), 0.01);
+  double previous = 1.0;
+  for (std::int64_t e = 0; e <= 2500; e += 50) {
+    const double s = mutation_sigma_m(c, e);
+    EXPECT_LT(s, previous);
+    previous = s;
+  }
+}
+
+TEST(Coevolution, BreedingUsesTheAnnealedStep) {
+  // Annealed within the first generation to a step a million times smaller: the
+  // copies bred after it differ from their parents by micrometres, not decimetres.
+  EvolveConfig c = small_config(FitnessMethod::historical, 0.3);
+  c.sigma_final_m = 3e-7;
+  c.anneal_episodes = 6;
+  Coevolution evo(c);
+  (void)record_generation(evo, 6, 0.0);
+  evo.select_and_breed();
+  int changed = 0;
+  for (std::size_t p = 0; p < 3; ++p) {
+    for (int m = 2; m < 4; ++m) {
+      for (std::size_t j = 0; j < 2; ++j) {
+        const double copy = evo.populations()[p][m].rest_lengths_m[j];
+        const double parent = evo.populations()[p][m - 2].rest_lengths_m[j];
+        EXPECT_NEAR(copy, parent, 3e-6);
+        if (copy != parent) ++changed;
+      }
+    }
+  }
+  EXPECT_GT(changed, 0) << "still mutated, by the final step";
+}
+
+TEST(Coevolution, RejectsBadMutationSchedules) {
+  EvolveConfig c = small_config(FitnessMethod::historical, 0.05);
+  c.sigma_final_m = -0.01;
+  EXPECT_THROW(Coevolution{c}, ConfigError);
+  c.sigma_final_m = 0.01;
+  c.anneal_episodes = -1;
+  EXPECT_THROW(Coevolution{c}, ConfigError);
+  c.anneal_episodes = 100;
+  c.sigma_final_m = 0.0;  // a geometric schedule cannot reach 0
+  try {
+    Coevolution evo{c};
+    ADD_FAILURE() << "accepted an annealing to a zero step";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("sigma_final_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Coevolution, AnUnscoredMemberRanksLast) {
   Coevolution evo(small_config(FitnessMethod::historical));
   // One team only: in each population one member is scored, three are not.
