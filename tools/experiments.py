@@ -66,9 +66,19 @@ def parse_args():
                    help="evolutions at once, one thread each (default: the cores, %(default)s)")
     p.add_argument("--duration", type=float, default=60.0,
                    help="episode length, s (default: the paper's %(default)s; shorter only for smoke tests)")
+    p.add_argument("--sigma", type=float, default=0.05, help="mutation step, m (default: %(default)s)")
+    p.add_argument("--sigma-final", type=float, default=None,
+                   help="anneal the step to this, m (default: no annealing; see docs/evolve.md)")
+    p.add_argument("--anneal-episodes", type=int, default=0,
+                   help="episodes over which the step anneals (default: %(default)s)")
     p.add_argument("--plot-only", action="store_true", help="do not run anything; plot what is there")
     a = p.parse_args()
     a.sweep_episodes = a.sweep_episodes or a.episodes
+    if (a.sigma_final is None) != (a.anneal_episodes == 0):
+        p.error("--sigma-final and --anneal-episodes go together")
+    # Runs with another mutation than the default get their own directories.
+    a.mutation_tag = "" if a.sigma_final is None and a.sigma == 0.05 else (
+        f"-m{a.sigma:g}" + ("" if a.sigma_final is None else f"-{a.sigma_final:g}-{a.anneal_episodes}"))
     a.method_seeds = a.method_seeds or a.seeds
     a.sweep_seeds = a.sweep_seeds or a.seeds
     a.periods = [float(x) for x in a.periods.split(",") if x]
@@ -92,7 +102,7 @@ def plan(a):
     runs = {}
 
     def add(method, period, complexity, episodes, seed):
-        key = run_id(method, period, complexity, episodes, seed, a.duration)
+        key = run_id(method, period, complexity, episodes, seed, a.duration) + a.mutation_tag
         runs[key] = dict(method=method, period=period, complexity=complexity, episodes=episodes, seed=seed)
 
     # The headline runs first (historical, t = 4 s, n = 5): they are what a cut-short
@@ -125,7 +135,9 @@ def run_one(a, key, r, progress):
     cmd = [a.tensegrity, "evolve", "--robot", a.robot, "--method", r["method"], "--period", f"{r['period']:g}",
            "--complexity", str(r["complexity"]), "--episodes", str(r["episodes"]), "--seed", str(r["seed"]),
            "--duration", f"{a.duration:g}", "--threads", "1", "--checkpoint", str(ckpt), "--out", str(d / "policy.json"),
-           "--log", str(d / "curve.csv"), "--json"]
+           "--log", str(d / "curve.csv"), "--json", "--sigma", f"{a.sigma:g}"]
+    if a.sigma_final is not None:
+        cmd += ["--sigma-final", f"{a.sigma_final:g}", "--anneal-episodes", str(a.anneal_episodes)]
     if (ckpt / "checkpoint.json").exists():
         cmd.append("--resume")
     progress(key, "started")
