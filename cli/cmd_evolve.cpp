@@ -39,6 +39,7 @@ struct EvolveArgs {
   double sigma_m = 0.05;
   double sigma_final_m = -1.0;  // not given: sigma_m
   std::int64_t anneal_episodes = 0;
+  std::int64_t anneal_start_episodes = 0;
   double duration_s = 60.0;
   std::string out;
   std::string log;
@@ -90,6 +91,7 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   config.sigma_m = args.sigma_m;
   config.sigma_final_m = args.sigma_final_m < 0.0 ? args.sigma_m : args.sigma_final_m;
   config.anneal_episodes = args.anneal_episodes;
+  config.anneal_start_episodes = args.anneal_start_episodes;
   config.seed = args.seed;
   config.episodes = args.episodes;
   config.complexity = args.complexity;
@@ -151,6 +153,7 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   policy.provenance.sigma_m = config.sigma_m;
   policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
   policy.provenance.anneal_episodes = config.anneal_episodes;
+  policy.provenance.anneal_start_episodes = config.anneal_episodes > 0 ? config.anneal_start_episodes : 0;
   sim::save_policy(args.out, policy);
 
   const std::int64_t episodes_here = evo.episodes() - result.resumed_episodes;
@@ -223,6 +226,9 @@ void add_evolve_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_option("--anneal-episodes", args->anneal_episodes,
                   "Episodes over which the step goes geometrically from --sigma to --sigma-final (0: constant)")
+      ->capture_default_str()->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+  cmd->add_option("--anneal-start", args->anneal_start_episodes,
+                  "Episodes at the constant --sigma before annealing begins")
       ->capture_default_str()->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();

@@ -118,7 +118,9 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
       pr.sigma_m = finite_number(m->value("sigma_m", json()), source, "provenance.mutation.sigma_m");
       pr.sigma_final_m = finite_number(m->value("sigma_final_m", json()), source, "provenance.mutation.sigma_final_m");
       pr.anneal_episodes = integer(m->value("anneal_episodes", json()), source, "provenance.mutation.anneal_episodes");
-      if (pr.sigma_m < 0.0 || pr.sigma_final_m < 0.0 || pr.anneal_episodes < 0) {
+      pr.anneal_start_episodes =
+          integer(m->value("anneal_start_episodes", json(0)), source, "provenance.mutation.anneal_start_episodes");
+      if (pr.sigma_m < 0.0 || pr.sigma_final_m < 0.0 || pr.anneal_episodes < 0 || pr.anneal_start_episodes < 0) {
         fail(source, "provenance.mutation", "steps and anneal_episodes must be >= 0");
       }
     }
@@ -173,7 +175,8 @@ std::string policy_to_json(const Policy& policy) {
   const Provenance& pr = policy.provenance;
   if (pr.sigma_m > 0.0) {
     doc["provenance"]["mutation"] = {
-        {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_episodes", pr.anneal_episodes}};
+        {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_start_episodes", pr.anneal_start_episodes},
+        {"anneal_episodes", pr.anneal_episodes}};
   }
   return doc.dump(2) + "\n";
 }

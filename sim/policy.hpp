@@ -35,6 +35,7 @@ struct Provenance {
   // method + seed + episodes + this reproduce the policy. sigma_m 0: not recorded.
   double sigma_m = 0.0;
   double sigma_final_m = 0.0;
+  std::int64_t anneal_start_episodes = 0;
   std::int64_t anneal_episodes = 0;
 };
 

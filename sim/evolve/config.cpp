@@ -34,6 +34,7 @@ void validate(const EvolveConfig& c) {
   if (!(c.sigma_m >= 0.0) || !std::isfinite(c.sigma_m)) fail("sigma_m must be finite and >= 0");
   if (!(c.sigma_final_m >= 0.0) || !std::isfinite(c.sigma_final_m)) fail("sigma_final_m must be finite and >= 0");
   if (c.anneal_episodes < 0) fail("anneal_episodes must be >= 0");
+  if (c.anneal_start_episodes < 0) fail("anneal_start_episodes must be >= 0");
   if (c.anneal_episodes > 0 && (c.sigma_m == 0.0) != (c.sigma_final_m == 0.0)) {
     fail("sigma_m and sigma_final_m must both be > 0 to anneal (the step changes geometrically)");
   }
@@ -52,9 +53,10 @@ void validate(const EvolveConfig& c) {
 
 double mutation_sigma_m(const EvolveConfig& c, std::int64_t episodes_done) {
   if (c.anneal_episodes <= 0 || c.sigma_m == c.sigma_final_m) return c.sigma_m;
-  if (episodes_done >= c.anneal_episodes) return c.sigma_final_m;
-  const double progress = static_cast<double>(std::max<std::int64_t>(episodes_done, 0)) /
-                          static_cast<double>(c.anneal_episodes);
+  const std::int64_t into = episodes_done - c.anneal_start_episodes;
+  if (into <= 0) return c.sigma_m;
+  if (into >= c.anneal_episodes) return c.sigma_final_m;
+  const double progress = static_cast<double>(into) / static_cast<double>(c.anneal_episodes);
   return c.sigma_m * std::pow(c.sigma_final_m / c.sigma_m, progress);
 }
 
@@ -66,6 +68,7 @@ nlohmann::json config_to_json(const EvolveConfig& c) {
                         {"sigma_m", c.sigma_m},
                         // Without annealing the final step is the step, whatever the field holds.
                         {"sigma_final_m", c.anneal_episodes > 0 ? c.sigma_final_m : c.sigma_m},
+                        {"anneal_start_episodes", c.anneal_episodes > 0 ? c.anneal_start_episodes : 0},
                         {"anneal_episodes", c.anneal_episodes},
                         {"seed", c.seed},
                         {"episodes", c.episodes},
@@ -90,6 +93,7 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     // Checkpoints from before annealing existed mutated with sigma_m throughout.
     c.sigma_final_m = j.value("sigma_final_m", c.sigma_m);
     c.anneal_episodes = j.value("anneal_episodes", std::int64_t{0});
+    c.anneal_start_episodes = j.value("anneal_start_episodes", std::int64_t{0});
     c.seed = j.at("seed").get<std::uint64_t>();
     c.episodes = j.at("episodes").get<std::int64_t>();
     c.cables = j.at("cables").get<int>();

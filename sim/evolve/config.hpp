@@ -34,12 +34,13 @@ struct EvolveConfig {
   int teams = 50;       // random teams evaluated per generation
   int replace = 5;      // worst members replaced by mutated copies of the best
   // Mutation: every value of a copy gets a N(0, sigma^2) step, clamped to the limits.
-  // sigma goes geometrically from sigma_m to sigma_final_m over the first
-  // anneal_episodes episodes and then stays there; anneal_episodes 0 keeps sigma_m.
-  // (The paper says only "mutate"; a step that explores a random start is ten times
-  // what refines a gait, docs/results.md.)
+  // sigma stays sigma_m for anneal_start_episodes episodes, then goes geometrically
+  // to sigma_final_m over anneal_episodes more and stays there; anneal_episodes 0
+  // keeps sigma_m. (The paper says only "mutate"; a step that explores a random
+  // start is five times what refines a gait, docs/results.md.)
   double sigma_m = 0.05;
   double sigma_final_m = 0.05;
+  std::int64_t anneal_start_episodes = 0;
   std::int64_t anneal_episodes = 0;
   std::uint64_t seed = 0;
   std::int64_t episodes = 5000;  // budget; the last generation may have fewer teams

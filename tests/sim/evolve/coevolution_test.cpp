@@ -198,6 +198,52 @@ TEST(Coevolution, MutationStepAnnealsGeometricallyThenStays) {
   }
 }
 
+TEST(Coevolution, AnnealingCanStartLate) {
+  EvolveConfig c = small_config(FitnessMethod::historical, 0.05);
+  c.sigma_final_m = 0.01;
+  c.anneal_start_episodes = 5000;
+  c.anneal_episodes = 1000;
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 0), 0.05);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 5000), 0.05);
+  EXPECT_NEAR(mutation_sigma_m(c, 5500), std::sqrt(0.05 * 0.01), 1e-15);
+  EXPECT_DOUBLE_EQ(mutation_sigma_m(c, 6000), 0.01);
+}
+
+// The schedule changes nothing but the step: a run at a constant step, continued
+// from its state with a smaller one, is the run whose schedule drops the step at
+// that episode (--anneal-start E --anneal-episodes 1). That is how a policy refined
+// from a checkpoint can be made again by one command.
+TEST(Coevolution, ALateStepDropEqualsAContinuationWithASmallerStep) {
+  EvolveConfig constant = testing::synthetic_config(FitnessMethod::historical, 1200, 5);
+  constant.sigma_m = 0.05;
+  EvolveConfig dropped = constant;
+  dropped.sigma_final_m = 0.01;
+  dropped.anneal_start_episodes = 600;
+  dropped.anneal_episodes = 1;
+  EvolveConfig smaller = constant;
+  smaller.sigma_m = 0.01;
+  FunctionEvaluator evaluator(testing::synthetic_score);
+
+  Coevolution one(dropped);
+  while (!one.done()) (void)one.step(evaluator);
+
+  Coevolution first(constant);
+  while (first.episodes() < 600) (void)first.step(evaluator);
+  Coevolution second(smaller, first.state());
+  while (!second.done()) (void)second.step(evaluator);
+
+  ASSERT_EQ(one.curve().size(), second.curve().size());
+  for (std::size_t g = 0; g < one.curve().size(); ++g) {
+    EXPECT_EQ(one.curve()[g].best_score_m, second.curve()[g].best_score_m) << "generation " << g + 1;
+  }
+  for (std::size_t c = 0; c < one.populations().size(); ++c) {
+    for (std::size_t m = 0; m < one.populations()[c].size(); ++m) {
+      EXPECT_EQ(one.populations()[c][m].rest_lengths_m, second.populations()[c][m].rest_lengths_m);
+    }
+  }
+  EXPECT_GT(one.best().score_m, 0.0);
+}
+
 TEST(Coevolution, BreedingUsesTheAnnealedStep) {
   // Annealed within the first generation to a step a million times smaller: the
   // copies bred after it differ from their parents by micrometres, not decimetres.
