@@ -221,15 +221,20 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
   cmd->add_option("--sigma", args->sigma_m, "Mutation step, metres (Gaussian, clamped to the limits)")->capture_default_str()->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--sigma-final", args->sigma_final_m,
-                  "Mutation step after --anneal-episodes, metres (default: --sigma, no annealing)")
-      ->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--anneal-episodes", args->anneal_episodes,
-                  "Episodes over which the step goes geometrically from --sigma to --sigma-final (0: constant)")
-      ->capture_default_str()->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
-  cmd->add_option("--anneal-start", args->anneal_start_episodes,
-                  "Episodes at the constant --sigma before annealing begins")
-      ->capture_default_str()->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+  // The schedule's three options go together: a step given without its episodes
+  // (or the reverse) would be silently ignored.
+  CLI::Option* sigma_final = cmd->add_option("--sigma-final", args->sigma_final_m,
+                                             "Mutation step after --anneal-episodes, metres (default: no annealing)")
+                                 ->check(CLI::Range(0.0, 10.0));
+  CLI::Option* anneal = cmd->add_option("--anneal-episodes", args->anneal_episodes,
+                                        "Episodes over which the step goes geometrically from --sigma to --sigma-final")
+                            ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  CLI::Option* anneal_start = cmd->add_option("--anneal-start", args->anneal_start_episodes,
+                                              "Episodes at the constant --sigma before annealing begins (default 0)")
+                                  ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+  sigma_final->needs(anneal);
+  anneal->needs(sigma_final);
+  anneal_start->needs(anneal);
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
