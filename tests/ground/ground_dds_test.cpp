@@ -316,8 +316,19 @@ TEST_F(GroundDds, KillingTheHostLeavesEndcapsBehavingAsConfigured) {
     EXPECT_FALSE(e.heartbeat.host_lost());
   }
   host_->kill_hard();
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-  const auto snap = s.snapshot();
+  // Loss is declared 0.5 s after the last host heartbeat; seeing it here also takes
+  // the end caps' next heartbeats, which a loaded CI host delays (a fixed 1.5 s once
+  // was not enough). Wait for every end cap to report it, up to 10 s.
+  auto snap = s.snapshot();
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (std::chrono::steady_clock::now() < give_up &&
+         !std::all_of(snap.begin(), snap.end(), [](const auto& e) { return e.heartbeat.host_lost(); })) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    snap = s.snapshot();
+  }
+  // The stopping end caps stop within their next cycle; give them one more heartbeat.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  snap = s.snapshot();
   for (int e = 0; e < kEndcapCount; ++e) {
     const auto& hb = snap[static_cast<std::size_t>(e)].heartbeat;
     EXPECT_TRUE(hb.host_lost()) << "end cap " << e;
