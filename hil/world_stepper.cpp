@@ -307,6 +307,37 @@ std::string WorldStepper::boot_report() const {
   return s.str();
 }
 
+// Lockstep owns time: nothing moves while an end cap's program starts again, as
+// nothing moves while one is slow to answer. The physics time the end cap misses is
+// then the scenario's (from its kill to its restart, plus its bring-up in SYNC ticks),
+// not however long the host takes to start a process, and a run with restarts is as
+// reproducible as one without.
+void WorldStepper::await_restarted() {
+  const std::int64_t t0 = monotonic_ns();
+  for (;;) {
+    std::string waiting;
+    for (int e = 0; e < endcap_count(); ++e) {
+      Endcap& ec = endcaps_[e];
+      if (ec.state != EndcapState::waiting_process) continue;
+      if (processes_.listening(e)) {
+        ec.state = EndcapState::live;
+        ec.first_answer_pending = true;
+      } else {
+        waiting += " end cap " + std::to_string(e) + " (" + processes_.describe(e) + ");";
+      }
+    }
+    if (waiting.empty()) return;
+    if (stop_requested()) throw HilError("interrupted");
+    if (monotonic_ns() - t0 > config_.boot_timeout_ns) {
+      std::ostringstream why;
+      why << "lockstep: a restarted program is not listening on its bus within " << ns_to_s(config_.boot_timeout_ns)
+          << " s (physics step " << stats_.steps << "):" << waiting;
+      throw HilError(why.str());
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
 void WorldStepper::boot() {
   const std::int64_t t0 = monotonic_ns();
   for (Endcap& ec : endcaps_) {
@@ -352,7 +383,7 @@ void WorldStepper::run(double duration_s) {
   for (std::int64_t i = 0; i < steps; ++i) {
     apply_due_events();
     update_frame_faults();
-    admit_listening();
+    await_restarted();
     lockstep_tick(true);
   }
   stats_.run_wall_s = ns_to_s(monotonic_ns() - t0);

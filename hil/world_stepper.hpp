@@ -23,7 +23,8 @@
 // which is physics step 0 and table time 0 on every end cap (start on boot starts
 // the table in the cycle that sees the drives enabled). An end cap that comes back
 // later (restart, fault reset) waits at the gate until a multiple of the policy
-// period, so it rejoins in phase.
+// period, so it rejoins in phase. While a restarted program starts (no bus socket
+// yet) no tick happens at all: a restart costs the same physics time on any host.
 //
 // Real time: the end caps run their own 1 kHz timers and send SYNC; the devices
 // answer SYNC; the stepper paces physics to the wall clock and counts late steps.
@@ -166,6 +167,7 @@ class WorldStepper {
 
   std::int64_t now_device_ns() const { return ticks_ * period_ns_; }
   void admit_listening();
+  void await_restarted();  // lockstep run: hold time until restarted programs listen
   void lockstep_tick(bool physics);
   void barrier(std::int64_t tick);
   void route(const std::vector<UdpHub::Rx>& rx);  // serve() and send the answers
