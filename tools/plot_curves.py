@@ -27,6 +27,7 @@ def main():
     ap.add_argument("--ylabel", default="best distance so far, m in 60 s")
     ap.add_argument("--hline", type=float, action="append", default=[],
                     help="a horizontal reference line, e.g. the paper's 32 m")
+    ap.add_argument("--legend-loc", default="best", help="matplotlib legend location, e.g. 'lower right'")
     a = ap.parse_args()
 
     fig, ax = plt.subplots(figsize=(8, 5))
@@ -51,7 +52,7 @@ def main():
     ax.set_ylabel(a.ylabel)
     ax.set_title(a.title)
     ax.grid(alpha=0.3)
-    ax.legend()
+    ax.legend(loc=a.legend_loc, fontsize="small")
     fig.tight_layout()
     fig.savefig(a.out, dpi=110)
 
