@@ -240,6 +240,11 @@ bool ProcessLauncher::listening(int e) {
   return false;
 }
 
+bool ProcessLauncher::exited(int e) {
+  reap(e, false);
+  return slots_[e].pid <= 0 && slots_[e].exit_status != -1;
+}
+
 std::string ProcessLauncher::describe(int e) {
   reap(e, false);
   const Slot& s = slots_[e];

@@ -64,6 +64,7 @@ class ProcessLauncher final : public EndcapProcesses {
   double cpu_s(int endcap) const;
 
   bool listening(int endcap) override;
+  bool exited(int endcap) override;
   std::string describe(int endcap) override;
   void kill(int endcap) override;
   void restart(int endcap) override;

@@ -328,6 +328,11 @@ void WorldStepper::await_restarted() {
     }
     if (waiting.empty()) return;
     if (stop_requested()) throw HilError("interrupted");
+    for (int e = 0; e < endcap_count(); ++e) {
+      if (endcaps_[e].state != EndcapState::waiting_process || !processes_.exited(e)) continue;
+      throw HilError("lockstep: end cap " + std::to_string(e) + "'s restarted program exited before it listened on its bus (physics step " +
+                     std::to_string(stats_.steps) + "): " + processes_.describe(e));
+    }
     if (monotonic_ns() - t0 > config_.boot_timeout_ns) {
       std::ostringstream why;
       why << "lockstep: a restarted program is not listening on its bus within " << ns_to_s(config_.boot_timeout_ns)
@@ -335,6 +340,19 @@ void WorldStepper::await_restarted() {
       throw HilError(why.str());
     }
     std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+// Without this a program that fails at start (a bad config, a missing library) would
+// cost the whole boot timeout and then be reported among the slow ones.
+void WorldStepper::fail_on_exit() {
+  const std::int64_t now = monotonic_ns();
+  if (now - last_exit_check_ns_ < kAdmitCheckPeriodNs) return;
+  last_exit_check_ns_ = now;
+  for (int e = 0; e < endcap_count(); ++e) {
+    if (!processes_.exited(e)) continue;
+    throw HilError("boot: end cap " + std::to_string(e) + "'s program exited before the start gate: " +
+                   processes_.describe(e));
   }
 }
 
@@ -351,6 +369,7 @@ void WorldStepper::boot() {
     for (;;) {
       admit_listening();
       if (all_at_gate()) break;
+      fail_on_exit();
       if (monotonic_ns() - t0 > config_.boot_timeout_ns) throw HilError(boot_report());
       bool any_to_tick = false;
       for (const Endcap& ec : endcaps_) any_to_tick = any_to_tick || (ec.state == EndcapState::live && !ec.devices.at_gate());
@@ -420,6 +439,7 @@ void WorldStepper::boot_realtime() {
       }
       if (all_enabled) return;
     }
+    fail_on_exit();
     if (monotonic_ns() - t0 > config_.boot_timeout_ns) throw HilError(boot_report());
   }
 }

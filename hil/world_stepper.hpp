@@ -54,6 +54,8 @@ class EndcapProcesses {
   virtual ~EndcapProcesses() = default;
   // Its bus socket exists: frames sent to it now queue until it reads them.
   virtual bool listening(int endcap) = 0;
+  // Its program was started and has ended since: it will not answer until restarted.
+  virtual bool exited(int endcap) = 0;
   // For error messages: "pid 1234, running", "exited with status 2".
   virtual std::string describe(int endcap) = 0;
   virtual void kill(int endcap) = 0;
@@ -168,6 +170,7 @@ class WorldStepper {
   std::int64_t now_device_ns() const { return ticks_ * period_ns_; }
   void admit_listening();
   void await_restarted();  // lockstep run: hold time until restarted programs listen
+  void fail_on_exit();     // boot: an end cap whose program ended will never reach the gate
   void lockstep_tick(bool physics);
   void barrier(std::int64_t tick);
   void route(const std::vector<UdpHub::Rx>& rx);  // serve() and send the answers
@@ -208,6 +211,7 @@ class WorldStepper {
   std::vector<double> preferred_;
   Eigen::Vector3d start_centre_;
   std::int64_t ticks_ = 0;  // device time in ticks, boot included
+  std::int64_t last_exit_check_ns_ = 0;
   bool started_ = false;
   StepperStats stats_;
   std::vector<std::string> log_;

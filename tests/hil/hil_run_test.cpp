@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 #include <set>
 #include <string>
@@ -94,6 +95,53 @@ TEST(HilRun, BootNamesAnEndCapThatNeverStarted) {
   ASSERT_FALSE(r.ok);
   EXPECT_NE(r.error.find("end cap 7 has no bus socket (not started)"), std::string::npos) << r.error;
   EXPECT_EQ(r.error.find("end cap 6"), std::string::npos) << r.error;
+}
+
+// A program that cannot start (here: an option it does not know) fails the boot
+// at once with its own reason, not after the boot timeout among the slow ones.
+TEST(HilRun, BootFailsAtOnceNamingAnEndCapWhoseProgramExited) {
+  HilOptions o = options(1.0);
+  o.endcap_extra_args[3] = {"--no-such-option"};
+  o.boot_timeout_s = 60.0;
+  const HilResult r = run_hil(o);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("boot: end cap 3's program exited before the start gate: process exited with status"),
+            std::string::npos)
+      << r.error;
+  EXPECT_EQ(r.error.find("within 60 s"), std::string::npos) << r.error;
+  EXPECT_TRUE(child_pids().empty());
+}
+
+// Lockstep holds time while a restarted program starts; one that exits instead
+// (its config broken while it was down) ends the run with its reason at the step
+// of the restart, rather than holding time for the whole boot timeout.
+TEST(HilRun, LockstepNamesARestartedProgramThatExits) {
+  HilOptions o = options(3.0);
+  ScenarioEvent kill;
+  kill.time_s = 1.0;
+  kill.endcap = 4;
+  kill.fault = FaultKind::kill_endcap;
+  ScenarioEvent restart = kill;
+  restart.time_s = 1.5;
+  restart.fault = FaultKind::restart_endcap;
+  o.scenario.events = {kill, restart};
+  o.boot_timeout_s = 60.0;
+  bool broken = false;
+  o.after_step = [&broken](const WorldStepper& s, ProcessLauncher& l) {
+    if (!broken && s.step_index() == 1200) {
+      std::ofstream(l.dir() / "endcap4" / "endcap.json") << "{";
+      broken = true;
+    }
+  };
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(broken);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("lockstep: end cap 4's restarted program exited before it listened on its bus (physics step "
+                         "1500): process exited with status 2; last log line: "),
+            std::string::npos)
+      << r.error;
+  EXPECT_NE(r.error.find("not valid JSON"), std::string::npos) << r.error;
+  EXPECT_TRUE(child_pids().empty());
 }
 
 TEST(HilRun, BarrierTimeoutNamesAStoppedEndCap) {
