@@ -330,7 +330,8 @@ void WorldStepper::await_restarted() {
     if (stop_requested()) throw HilError("interrupted");
     for (int e = 0; e < endcap_count(); ++e) {
       if (endcaps_[e].state != EndcapState::waiting_process || !processes_.exited(e)) continue;
-      throw HilError("lockstep: end cap " + std::to_string(e) + "'s restarted program exited before it listened on its bus (physics step " +
+      throw HilError("lockstep: end cap " + std::to_string(e) +
+                     "'s restarted program exited before it listened on its bus (physics step " +
                      std::to_string(stats_.steps) + "): " + processes_.describe(e));
     }
     if (monotonic_ns() - t0 > config_.boot_timeout_ns) {
