@@ -50,6 +50,12 @@ class RealEndcaps : public ::testing::Test {
     fs::create_directories(dir_);
     // The end caps take their domain from the environment, as on the robot.
     ::setenv("TENSEGRITY_DOMAIN", std::to_string(kDomain).c_str(), 1);
+    // The HIL launcher's ports: below the ephemeral range, so that no socket binding
+    // port 0 (a DDS participant's sender) takes one before the programs bind them.
+    // All at once: a port is free again as soon as it is chosen, so two picks made
+    // before the first end cap has bound its ports can return the same one
+    // ("Address already in use", 2 runs in 17 under load).
+    ports_ = hil::free_udp_ports(2 * kEndcapCount);
   }
   void TearDown() override {
     // End caps first: a device simulator gone first would fault them (noise in the logs).
@@ -70,11 +76,8 @@ class RealEndcaps : public ::testing::Test {
 
   void start_endcap(int e) {
     const std::string tag = std::to_string(e);
-    // The HIL launcher's ports: below the ephemeral range, so that no socket binding
-    // port 0 (a DDS participant's sender) takes one before the programs bind them.
-    const std::vector<std::uint16_t> ports = hil::free_udp_ports(2);
-    const std::uint16_t endcap_port = ports[0];
-    const std::uint16_t device_port = ports[1];
+    const std::uint16_t endcap_port = ports_[2 * e];
+    const std::uint16_t device_port = ports_[2 * e + 1];
     const json config = {
         {"format", "tensegrity-endcap/1"},
         {"bus", "udp:127.0.0.1:" + std::to_string(device_port) + ",bind=127.0.0.1:" + std::to_string(endcap_port)},
@@ -129,6 +132,7 @@ class RealEndcaps : public ::testing::Test {
   }
 
   fs::path dir_;
+  std::vector<std::uint16_t> ports_;  // end cap e: bus port 2e, its devices 2e + 1
   std::vector<std::unique_ptr<Subprocess>> devices_;
   std::vector<std::unique_ptr<Subprocess>> endcaps_;
   std::unique_ptr<Station> observer_;
@@ -230,8 +234,12 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
 
   // 6. Each end cap shuts down cleanly on SIGTERM while the host still answers its
   // time-sync requests (a reply racing the node's teardown used to end in SIGSEGV).
+  // The exit code is what is checked, not the time to it: on this loaded 2-core VM
+  // one end cap was still not reaped 3 s after SIGTERM in 2 runs of 44, and the one
+  // inspected had already exited (a zombie: its threads gone from user space).
   for (int e = 0; e < kEndcapCount; ++e) {
-    EXPECT_EQ(endcaps_[static_cast<std::size_t>(e)]->stop(), 0) << "end cap " << e << " exit status";
+    EXPECT_EQ(endcaps_[static_cast<std::size_t>(e)]->stop(std::chrono::seconds(15)), 0)
+        << "end cap " << e << " exit status";
   }
 }
 

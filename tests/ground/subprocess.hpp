@@ -11,8 +11,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -81,12 +83,14 @@ class Subprocess {
     ::waitpid(pid_, nullptr, 0);
     pid_ = -1;
   }
-  // SIGTERM, then SIGKILL after 3 s. Its exit code, 128 + the signal that ended it,
-  // or -1 when it had to be killed (or was not running).
-  int stop() {
+  // SIGTERM, then SIGKILL after `grace`. Its exit code, 128 + the signal that ended
+  // it, or -1 when it had to be killed (or was not running); then what its threads
+  // were doing goes to stderr, for the test's log.
+  int stop(std::chrono::milliseconds grace = std::chrono::seconds(3)) {
     if (pid_ <= 0) return -1;
     ::kill(pid_, SIGTERM);
-    for (int i = 0; i < 300; ++i) {
+    const auto deadline = std::chrono::steady_clock::now() + grace;
+    while (std::chrono::steady_clock::now() < deadline) {
       int status = 0;
       if (::waitpid(pid_, &status, WNOHANG) == pid_) {
         pid_ = -1;
@@ -94,8 +98,30 @@ class Subprocess {
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
+    std::fprintf(stderr, "pid %d still there %lld ms after SIGTERM:\n%s", static_cast<int>(pid_),
+                 static_cast<long long>(grace.count()), thread_states().c_str());
     kill_hard();
     return -1;
+  }
+  // One line per thread: id, name, state (R, S, D, Z...) and the kernel function it
+  // waits in.
+  std::string thread_states() const {
+    std::string lines;
+    std::error_code ec;
+    const std::filesystem::path tasks = "/proc/" + std::to_string(pid_) + "/task";
+    for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
+      const auto read = [&task](const char* name) {
+        std::ifstream in(task.path() / name);
+        std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        while (!text.empty() && text.back() == '\n') text.pop_back();
+        return text;
+      };
+      const std::string stat = read("stat");
+      const auto close = stat.rfind(')');
+      const std::string state = close != std::string::npos && close + 2 < stat.size() ? stat.substr(close + 2, 1) : "?";
+      lines += "  " + task.path().filename().string() + " " + read("comm") + " " + state + " " + read("wchan") + "\n";
+    }
+    return lines.empty() ? "  (no threads left)\n" : lines;
   }
 
  private:
