@@ -34,14 +34,7 @@ TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
   // host however loaded.
   HilOptions o = options(10.0, c.provision);
   o.mode = c.mode;
-  ScenarioEvent kill;
-  kill.time_s = kill_s;
-  kill.endcap = 4;
-  kill.fault = FaultKind::kill_endcap;
-  ScenarioEvent restart = kill;
-  restart.time_s = kill_s + 0.5;
-  restart.fault = FaultKind::restart_endcap;
-  o.scenario.events = {kill, restart};
+  o.scenario.events = kill_and_restart(4, kill_s, kill_s + 0.5);
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
   const EndcapSummary& e4 = r.endcaps.at(4);

@@ -117,14 +117,7 @@ TEST(HilRun, BootFailsAtOnceNamingAnEndCapWhoseProgramExited) {
 // of the restart, rather than holding time for the whole boot timeout.
 TEST(HilRun, LockstepNamesARestartedProgramThatExits) {
   HilOptions o = options(3.0);
-  ScenarioEvent kill;
-  kill.time_s = 1.0;
-  kill.endcap = 4;
-  kill.fault = FaultKind::kill_endcap;
-  ScenarioEvent restart = kill;
-  restart.time_s = 1.5;
-  restart.fault = FaultKind::restart_endcap;
-  o.scenario.events = {kill, restart};
+  o.scenario.events = kill_and_restart(4, 1.0, 1.5);
   o.boot_timeout_s = 60.0;
   bool broken = false;
   o.after_step = [&broken](const WorldStepper& s, ProcessLauncher& l) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hil/hil_run.hpp"
+#include "hil/scenario.hpp"
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 
@@ -80,6 +81,18 @@ inline HilOptions options(double duration_s, Provision provision = default_provi
   o.boot_timeout_s = 20.0;
   o.provision = provision;
   return o;
+}
+
+// The scenario of a killed end cap whose program is started again.
+inline std::vector<ScenarioEvent> kill_and_restart(int endcap, double kill_s, double restart_s) {
+  ScenarioEvent kill;
+  kill.time_s = kill_s;
+  kill.endcap = endcap;
+  kill.fault = FaultKind::kill_endcap;
+  ScenarioEvent restart = kill;
+  restart.time_s = restart_s;
+  restart.fault = FaultKind::restart_endcap;
+  return {kill, restart};
 }
 
 // Live children of this process (an orphaned end cap would be one, or would
