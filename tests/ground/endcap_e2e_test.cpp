@@ -54,7 +54,7 @@ class RealEndcaps : public ::testing::Test {
     // port 0 (a DDS participant's sender) takes one before the programs bind them.
     // All at once: a port is free again as soon as it is chosen, so two picks made
     // before the first end cap has bound its ports can return the same one
-    // ("Address already in use", 2 runs in 17 under load).
+    // ("Address already in use", seen once in 17 runs under load).
     ports_ = hil::free_udp_ports(2 * kEndcapCount);
   }
   void TearDown() override {
