@@ -200,10 +200,16 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   });
   const bool all_running =
       wait_all([](const EndcapStatus& s) { return s.have_telemetry && s.telemetry.mode() == 1U; }, 10.0);
+  const auto window_start = std::chrono::steady_clock::now();
   std::this_thread::sleep_for(std::chrono::seconds(2));  // 2 s of playing, from the last one's start
   {
     const auto snap = observer_->snapshot();
     std::lock_guard lock(m);
+    const double window_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - window_start).count();
+    std::uint32_t slowest = ~0U;
+    for (int e = 0; e < kEndcapCount; ++e) slowest = std::min(slowest, last_seq[e] - first_seq[e]);
+    std::printf("MEASURE running_telemetry_sent_slowest_endcap_hz=%.1f (configured 100)\n",
+                static_cast<double>(slowest) / window_s);
     for (int e = 0; e < kEndcapCount; ++e) {
       const auto i = static_cast<std::size_t>(e);
       const std::string seen = " (all running: " + std::to_string(all_running) + ", telemetry samples " +
