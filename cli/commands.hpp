@@ -18,6 +18,8 @@ class CommandError : public std::runtime_error {
 };
 
 void add_sim_command(CLI::App& app);
+// `analyze`: Figures 10-12 of one episode (sim/analysis/).
+void add_analyze_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_evolve_command(CLI::App& app);
 // `bench evolve`, added by add_bench_command.
