@@ -96,10 +96,11 @@ json analysis_json(const an::EpisodeSeries& series, const an::Analysis& a, const
   j["samples"] = series.samples();
   j["endcaps"] = series.nodes();
   j["energy"] = energy_json(a);
-  j["revolution_period_s"] = {{"touchdowns", a.touchdown_period_s},
+  j["revolution_period_s"] = {{"contacts", a.contact_period.period_s},
+                              {"contacts_agreement", a.contact_period.agreement},
                               {"faces", a.cycle.period_s},
-                              {"rotation", a.rotation_period_s},
-                              {"touchdown_intervals", a.touchdown_intervals_s.size()}};
+                              {"rotation", a.rotation_period_s}};
+  j["touchdown_interval_s"] = {{"median", a.touchdown_interval_s}, {"count", a.touchdown_intervals_s.size()}};
   j["rolling"] = rolling_json(a);
   double spin_max = 0.0;
   for (const double s : a.axial_spin_mean_rad_per_s) spin_max = std::max(spin_max, s);
@@ -108,6 +109,7 @@ json analysis_json(const an::EpisodeSeries& series, const an::Analysis& a, const
                    {"cut_height", o.cluster_cut},
                    {"zero_lag", groups_of(a.clusters, a.tree.leaf_order)},
                    {"phase_aligned", groups_of(a.aligned_clusters, a.aligned_tree.leaf_order)}};
+  j["signal_peaks_per_period"] = a.peaks_per_period;
   return j;
 }
 
@@ -125,8 +127,8 @@ void print_analysis_summary(const json& j) {
   std::printf("  power per muscle mean %.2f W (muscles %.2f-%.2f W; 1 s mean %.2f-%.2f W)\n", p["mean"].get<double>(),
               p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(),
               p["mean_over_1s_min"].get<double>(), p["mean_over_1s_max"].get<double>());
-  std::printf("  revolution       %.2f s from touchdowns, %.2f s from faces (%d per cycle), %.2f s from rotation\n",
-              period["touchdowns"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
+  std::printf("  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle), %.2f s from rotation\n",
+              period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
               period["rotation"].get<double>());
   std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
               r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(), r["face_sequence"].size(),

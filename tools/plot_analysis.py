@@ -92,7 +92,7 @@ def fig11_time(d, s):
         ax.grid(alpha=0.3)
         ax.set_title(f"({letter})", loc="left", fontsize=9)
     p = s["revolution_period_s"]
-    axes[0].set_title(title(s, f"Fig. 11: revolution {p['touchdowns']:.2f} s (touchdowns), "
+    axes[0].set_title(title(s, f"Fig. 11: revolution {p['contacts']:.2f} s (contacts), "
                                f"{p['rotation']:.2f} s (rotation); signal period {s['period_s']:g} s"),
                       fontsize=9)
     fig.tight_layout()

@@ -31,7 +31,10 @@ void rolling_evidence(const EpisodeSeries& s, std::size_t first, const std::vect
   a.faces = face_sequence(s.time_s, a.contacts, cable_nodes, o.face_min_s);
   a.cycle = face_cycle(a.faces);
   a.touchdown_intervals_s = touchdown_intervals(a.contacts, a.window_start_s);
-  a.touchdown_period_s = a.touchdown_intervals_s.empty() ? 0.0 : quantile(a.touchdown_intervals_s, 0.5);
+  a.touchdown_interval_s = a.touchdown_intervals_s.empty() ? 0.0 : quantile(a.touchdown_intervals_s, 0.5);
+  // A revolution is longer than one signal period (the paper's is two); shorter
+  // shifts only find the signal's own period.
+  a.contact_period = contact_period(s.time_s, a.contacts, first, 0.5 * o.period_s);
   a.turning = accumulate_turning(s.node_m, first);
   const double revolutions = a.turning.revolutions();
   a.rotation_period_s = revolutions > 1e-6 ? (a.window_end_s - a.window_start_s) / revolutions : 0.0;
@@ -57,7 +60,11 @@ Analysis analyze(const EpisodeSeries& s, const std::vector<std::pair<int, int>>&
   a.tree = average_linkage(one_minus(a.correlation));
   a.clusters = cut(a.tree, o.cluster_cut);
   const std::size_t period_first = std::max(first, last_period_start(s, o.period_s));
-  a.aligned = aligned_correlation_matrix(signals(s, period_first, s.samples()));
+  const Matrix last_period = signals(s, period_first, s.samples());
+  a.aligned = aligned_correlation_matrix(last_period);
+  // 2 cm: well above the motors' 0.2 mm step at 1 kHz, a fifth of the smallest
+  // interval a learned signal spans.
+  for (const auto& signal : last_period) a.peaks_per_period.push_back(peaks_per_period(signal, 0.02));
   a.aligned_tree = average_linkage(one_minus(a.aligned.r));
   a.aligned_clusters = cut(a.aligned_tree, o.cluster_cut);
 

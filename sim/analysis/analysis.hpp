@@ -12,6 +12,7 @@
 #include "sim/analysis/muscle_stats.hpp"
 #include "sim/analysis/rotation.hpp"
 #include "sim/analysis/series.hpp"
+#include "sim/analysis/signal_shape.hpp"
 
 namespace tensegrity::sim::analysis {
 
@@ -39,12 +40,15 @@ struct Analysis {
   AlignedMatrix aligned;
   Dendrogram aligned_tree;
   std::vector<int> aligned_clusters;
+  // Per cable: peaks of its rest length in the last period (prominence 2 cm).
+  std::vector<int> peaks_per_period;
   // Rolling evidence.
   Contacts contacts;
   std::vector<GroundFace> faces;
   FaceCycle cycle;
   std::vector<double> touchdown_intervals_s;
-  double touchdown_period_s = 0.0;  // median of the intervals; 0 without any
+  double touchdown_interval_s = 0.0;  // median of the intervals; 0 without any
+  ContactPeriod contact_period;        // the revolution, from every end cap's contacts
   Turning turning;
   double rotation_period_s = 0.0;  // window length / revolutions; 0 when it does not turn
   SlipSummary slip;

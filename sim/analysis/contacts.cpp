@@ -82,6 +82,35 @@ std::vector<double> touchdown_intervals(const Contacts& contacts, double from_s)
   return out;
 }
 
+ContactPeriod contact_period(const std::vector<double>& time_s, const Contacts& contacts, std::size_t first,
+                             double min_s, double slack) {
+  const std::size_t n = time_s.size();
+  if (first + 4 > n) return {};
+  const double step = (time_s.back() - time_s[first]) / static_cast<double>(n - 1 - first);
+  const auto min_lag = std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(min_s / step)));
+  const std::size_t max_lag = (n - first) / 2;
+  std::vector<double> agree;  // by lag - min_lag
+  for (std::size_t lag = min_lag; lag <= max_lag; ++lag) {
+    std::size_t same = 0, total = 0;
+    for (std::size_t k = first; k + lag < n; ++k) {
+      for (std::size_t e = 0; e < contacts.touching[k].size(); ++e) {
+        same += contacts.touching[k][e] == contacts.touching[k + lag][e] ? 1 : 0;
+        ++total;
+      }
+    }
+    agree.push_back(total > 0 ? static_cast<double>(same) / static_cast<double>(total) : 0.0);
+  }
+  if (agree.empty()) return {};
+  const double best = *std::max_element(agree.begin(), agree.end());
+  for (std::size_t i = 0; i < agree.size(); ++i) {
+    // The first shift as good as the best, at its own local peak.
+    if (agree[i] < best - slack) continue;
+    while (i + 1 < agree.size() && agree[i + 1] > agree[i]) ++i;
+    return {static_cast<double>(i + min_lag) * step, agree[i]};
+  }
+  return {};
+}
+
 double quantile(std::vector<double> values, double q) {
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(values.begin(), values.end());

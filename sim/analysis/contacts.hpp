@@ -41,6 +41,19 @@ Contacts detect_contacts(const std::vector<double>& time_s, const std::vector<st
 // icosahedron sets each end cap of its band down once per revolution.
 std::vector<double> touchdown_intervals(const Contacts& contacts, double from_s);
 
+// The revolution period read off the whole contact pattern: the shortest shift in
+// [min_s, half the samples from `first`] at which which-end-caps-touch agrees with
+// itself as well as at the best shift (within `slack`). An end cap may touch down
+// once or twice a revolution, so the time between its touchdowns alone is not the
+// period; the pattern of all of them is. `agreement` is the share of (sample, end cap)
+// pairs that agree at that shift. Samples are taken as evenly spaced.
+struct ContactPeriod {
+  double period_s = 0.0;
+  double agreement = 0.0;
+};
+ContactPeriod contact_period(const std::vector<double>& time_s, const Contacts& contacts, std::size_t first,
+                             double min_s, double slack = 0.01);
+
 struct SlipSummary {
   double mean_m_per_s = 0.0;
   double median_m_per_s = 0.0;

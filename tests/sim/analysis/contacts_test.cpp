@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "sim/analysis/faces.hpp"
 
@@ -100,6 +101,37 @@ TEST(Faces, ARepeatingSequenceGivesItsCycleAndPeriod) {
   faces.resize(5);
   faces[3].nodes = {7, 8, 9};  // no repeat: 1 of 2 and 0 of 1 match
   EXPECT_EQ(face_cycle(faces).faces, 0);
+}
+
+}  // namespace
+}  // namespace tensegrity::sim::analysis
+
+namespace tensegrity::sim::analysis {
+namespace {
+
+// Six end caps rolling with a 3 s revolution; end cap 0 touches down twice in each,
+// so its touchdowns are 1.5 s apart, but the pattern repeats every 3 s.
+TEST(ContactPeriod, IsThePatternsPeriodNotTheTimeBetweenTouchdowns) {
+  std::vector<double> t;
+  std::vector<std::vector<Eigen::Vector3d>> p;
+  for (int k = 0; k < 1200; ++k) {
+    const double time = k / 100.0;
+    const double phase = std::fmod(time, 3.0);
+    std::vector<Eigen::Vector3d> nodes(6, Eigen::Vector3d(0, 0, 0.3));
+    for (int e = 1; e < 6; ++e) {
+      if (phase >= 0.6 * (e - 1) && phase < 0.6 * (e - 1) + 1.0) nodes[e].z() = kRadius;
+    }
+    if (std::fmod(time, 1.5) < 0.4) nodes[0].z() = kRadius;
+    t.push_back(time);
+    p.push_back(nodes);
+  }
+  const Contacts c = detect_contacts(t, p, kRadius);
+  const auto gaps = touchdown_intervals(c, 0.0);
+  EXPECT_NEAR(quantile(gaps, 0.5), 3.0, 1e-9);
+  EXPECT_NEAR(touchdown_intervals(Contacts{{}, {c.spans[0]}, {}, {}}, 0.0).front(), 1.5, 1e-9);
+  const ContactPeriod period = contact_period(t, c, 0, 0.5);
+  EXPECT_NEAR(period.period_s, 3.0, 0.011);
+  EXPECT_GT(period.agreement, 0.99);
 }
 
 }  // namespace
