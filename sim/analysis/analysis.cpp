@@ -37,7 +37,8 @@ void rolling_evidence(const EpisodeSeries& s, std::size_t first, const std::vect
   a.contact_period = contact_period(s.time_s, a.contacts, first, 0.5 * o.period_s);
   a.turning = accumulate_turning(s.node_m, first);
   const double revolutions = a.turning.revolutions();
-  a.rotation_period_s = revolutions > 1e-6 ? (a.window_end_s - a.window_start_s) / revolutions : 0.0;
+  // Less than one whole turn measures no period; extrapolating a rock would invent one.
+  a.rotation_period_s = revolutions >= 1.0 ? (a.window_end_s - a.window_start_s) / revolutions : 0.0;
   a.slip = summarize_slip(a.contacts, first + 1);
 }
 

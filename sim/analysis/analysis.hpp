@@ -50,7 +50,7 @@ struct Analysis {
   double touchdown_interval_s = 0.0;  // median of the intervals; 0 without any
   ContactPeriod contact_period;        // the revolution, from every end cap's contacts
   Turning turning;
-  double rotation_period_s = 0.0;  // window length / revolutions; 0 when it does not turn
+  double rotation_period_s = 0.0;  // window length / revolutions; 0 below one revolution
   SlipSummary slip;
   std::vector<double> axial_spin_mean_rad_per_s;  // per strut, over the window
 };
