@@ -134,6 +134,16 @@ GenerationStats Coevolution::record(const std::vector<TeamPicks>& picks, const s
   return stats;
 }
 
+void Coevolution::mutate(std::vector<double>& values, double sigma_m) {
+  const bool author = config_.mutation == Mutation::author;
+  // The draw order (copy, then per value: keep?, step) is part of a run's identity.
+  if (author && rng_.uniform01() < kAuthorCopyUntouchedProbability) return;
+  for (double& v : values) {
+    if (author && rng_.uniform01() < kAuthorValueUntouchedProbability) continue;
+    v = std::clamp(v + sigma_m * rng_.normal(), config_.min_rest_length_m, config_.max_rest_length_m);
+  }
+}
+
 void Coevolution::select_and_breed() {
   const auto n = static_cast<std::size_t>(config_.population);
   const auto z = static_cast<std::size_t>(config_.replace);
@@ -152,9 +162,7 @@ void Coevolution::select_and_breed() {
       Member& copy = ranked[n - z + i];
       copy.rest_lengths_m = ranked[i].rest_lengths_m;
       copy.history.clear();
-      for (double& v : copy.rest_lengths_m) {
-        v = std::clamp(v + sigma_m * rng_.normal(), config_.min_rest_length_m, config_.max_rest_length_m);
-      }
+      mutate(copy.rest_lengths_m, sigma_m);
     }
     if (config_.method != FitnessMethod::historical) {
       for (auto& member : ranked) member.history.clear();

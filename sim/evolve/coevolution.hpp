@@ -85,6 +85,8 @@ class Coevolution {
   GenerationStats record(const std::vector<TeamPicks>& picks, const std::vector<Team>& teams,
                          const std::vector<TeamResult>& results);
   void select_and_breed();
+  // A copy's values mutated in place by the config's operator at step `sigma_m`.
+  void mutate(std::vector<double>& values, double sigma_m);
 
  private:
   EvolveConfig config_;

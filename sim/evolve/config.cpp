@@ -24,6 +24,20 @@ FitnessMethod parse_fitness_method(const std::string& text) {
   throw ConfigError("unknown method '" + text + "' (historical, leniency or average)");
 }
 
+const char* to_string(Mutation mutation) {
+  switch (mutation) {
+    case Mutation::gaussian: return "gaussian";
+    case Mutation::author: return "author";
+  }
+  return "?";
+}
+
+Mutation parse_mutation(const std::string& text) {
+  if (text == "gaussian") return Mutation::gaussian;
+  if (text == "author") return Mutation::author;
+  throw ConfigError("unknown mutation '" + text + "' (author or gaussian)");
+}
+
 void validate(const EvolveConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("evolve config: " + what); };
   if (c.population < 2) fail("population must be at least 2");
@@ -64,6 +78,7 @@ nlohmann::json config_to_json(const EvolveConfig& c) {
                         {"population", c.population},
                         {"teams", c.teams},
                         {"replace", c.replace},
+                        {"mutation", to_string(c.mutation)},
                         {"sigma_m", c.sigma_m},
                         // Without annealing the final step is the step, whatever the field holds.
                         {"sigma_final_m", c.anneal_episodes > 0 ? c.sigma_final_m : c.sigma_m},
@@ -88,6 +103,8 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     c.population = j.at("population").get<int>();
     c.teams = j.at("teams").get<int>();
     c.replace = j.at("replace").get<int>();
+    // Checkpoints from before the author's operator existed mutated every value.
+    c.mutation = parse_mutation(j.value("mutation", std::string("gaussian")));
     c.sigma_m = j.at("sigma_m").get<double>();
     // Checkpoints from before annealing existed mutated with sigma_m throughout.
     c.sigma_final_m = j.value("sigma_final_m", c.sigma_m);

@@ -28,6 +28,23 @@ const char* to_string(FitnessMethod method);
 // Throws ConfigError naming the accepted values.
 FitnessMethod parse_fitness_method(const std::string& text);
 
+// How a copy of a survivor is mutated (docs/evolve.md has both, with sources).
+enum class Mutation {
+  gaussian,  // every value of every copy moves by N(0, sigma^2), clamped
+  // The author's NTRT operator (NeuroEvoMember::mutate): a copy stays as it is with
+  // probability 1/2; otherwise each value moves with probability 1/2 by N(0, sigma^2),
+  // clamped. NTRT's sigma is 0.03 of the normalised range.
+  author,
+};
+
+const char* to_string(Mutation mutation);
+Mutation parse_mutation(const std::string& text);
+// NTRT's step as a share of the rest-length range (0.015 m on 0.6-1.1 m).
+inline constexpr double kAuthorSigmaShareOfRange = 0.03;
+// NTRT's probabilities: a copy is left unmutated, a value of a mutated copy is left.
+inline constexpr double kAuthorCopyUntouchedProbability = 0.5;
+inline constexpr double kAuthorValueUntouchedProbability = 0.5;
+
 struct EvolveConfig {
   FitnessMethod method = FitnessMethod::historical;
   int population = 10;  // members per cable population
@@ -38,6 +55,7 @@ struct EvolveConfig {
   // to sigma_final_m over anneal_episodes more and stays there; anneal_episodes 0
   // keeps sigma_m. (The paper says only "mutate"; a step that explores a random
   // start is five times what refines a gait, docs/results.md.)
+  Mutation mutation = Mutation::gaussian;
   double sigma_m = 0.05;
   double sigma_final_m = 0.05;
   std::int64_t anneal_start_episodes = 0;
