@@ -2,6 +2,8 @@
 #include "sim/episode.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -104,6 +106,9 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
 
   EpisodeResult result;
   double tension_sum = 0.0;
+  double spin_sq_sum = 0.0;
+  std::uint32_t touched = 0;
+  const int struts = static_cast<int>(robot.struts.size());
   std::int64_t done = 0;
   for (std::int64_t k = 0; k < steps; ++k) {
     ControlInput input;
@@ -129,6 +134,12 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
       break;
     }
 
+    for (int s = 0; s < struts; ++s) {
+      const double w = model.axial_spin_rad_per_s(s);
+      spin_sq_sum += w * w;
+      result.axial_spin_max_rad_per_s = std::max(result.axial_spin_max_rad_per_s, std::abs(w));
+    }
+    touched |= model.ground_contact_mask();
     const auto tension = model.tension_n();
     const auto rate = model.rest_length_rate_m_per_s();
     double step_max = 0.0;
@@ -171,6 +182,8 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
   if (done > 0) {
     result.mean_tension_n = tension_sum / (static_cast<double>(done) * static_cast<double>(cables));
     result.mean_motor_power_w = result.motor_energy_j / (result.sim_time_s * static_cast<double>(cables));
+    result.axial_spin_rms_rad_per_s = std::sqrt(spin_sq_sum / (static_cast<double>(done) * std::max(1, struts)));
+    result.endcaps_touched_ground = std::popcount(touched);
   }
   result.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -11,6 +11,8 @@
 #include <string>
 
 #include "firmware/core/rate_limit.hpp"
+#include "sim/model_ode.hpp"
+#include "sim/strut_frame.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -37,31 +39,12 @@ void init_ode_for_this_thread() {
   (void)allocated;
 }
 
-Eigen::Vector3d vec(const dReal* v) { return {v[0], v[1], v[2]}; }
-// ODE keeps rotations as 3x4 row-major matrices; column 2 is the body z axis, which
-// is the strut's axis here.
-Eigen::Vector3d axis_of(const dReal* R) { return {R[2], R[6], R[10]}; }
+using ode_detail::axis_of;
+using ode_detail::rotation_of;
+using ode_detail::vec;
 
 }  // namespace
 
-struct Model::Ode {
-  dWorldID world = nullptr;
-  dJointGroupID contacts = nullptr;
-  // ODE's default stepping "threading" implementation is one process-wide object
-  // with fake (non-atomic) locks: two worlds stepped on two threads corrupt it. A
-  // self-threaded implementation per world makes worlds independent.
-  dThreadingImplementationID threading = nullptr;
-  std::vector<dBodyID> bodies;
-  std::vector<Eigen::Vector3d> inertia_diag;  // body frame, kg m^2
-  ~Ode() {
-    if (contacts != nullptr) dJointGroupDestroy(contacts);
-    if (world != nullptr) {
-      dWorldSetStepThreadingImplementation(world, nullptr, nullptr);
-      dWorldDestroy(world);
-    }
-    if (threading != nullptr) dThreadingFreeImplementation(threading);
-  }
-};
 
 Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_(std::make_unique<Ode>()) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
@@ -104,12 +87,34 @@ Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_
   node_vel_.assign(nodes, Eigen::Vector3d::Zero());
   node_arm_.assign(nodes, Eigen::Vector3d::Zero());
   unit_.assign(cables, Eigen::Vector3d::Zero());
+  arm_a_.assign(cables, Eigen::Vector3d::Zero());
+  arm_b_.assign(cables, Eigen::Vector3d::Zero());
+  surface_ = robot_.cable_attachment == CableAttachment::surface;
+  if (surface_) init_surface_attachments();
   force_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
   torque_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
   place(robot_.nodes_m);
 }
 
 Model::~Model() = default;
+
+void Model::init_surface_attachments() {
+  local_a_.assign(robot_.cables.size(), Eigen::Vector3d::Zero());
+  local_b_.assign(robot_.cables.size(), Eigen::Vector3d::Zero());
+  inner_run_m_.clear();
+  for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
+    const auto& c = robot_.cables[m];
+    local_a_[m] = surface_attachment(robot_, strut_of_node_[c.node_a], c.node_a, c.node_b);
+    local_b_[m] = surface_attachment(robot_, strut_of_node_[c.node_b], c.node_b, c.node_a);
+    const Eigen::Vector3d& a = robot_.nodes_m[c.node_a];
+    const Eigen::Vector3d& b = robot_.nodes_m[c.node_b];
+    const auto& strut_a = robot_.struts[strut_of_node_[c.node_a]];
+    const auto& strut_b = robot_.struts[strut_of_node_[c.node_b]];
+    const Eigen::Vector3d anchor_a = a + strut_frame(robot_.nodes_m, strut_a.node_a, strut_a.node_b) * local_a_[m];
+    const Eigen::Vector3d anchor_b = b + strut_frame(robot_.nodes_m, strut_b.node_a, strut_b.node_b) * local_b_[m];
+    inner_run_m_.push_back((b - a).norm() - (anchor_b - anchor_a).norm());
+  }
+}
 
 void Model::set_gravity_enabled(bool on) {
   dWorldSetGravity(ode_->world, 0, 0, on ? -robot_.gravity_m_per_s2 : 0.0);
@@ -120,7 +125,11 @@ void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
     const Eigen::Vector3d a = nodes_m[robot_.struts[s].node_a];
     const Eigen::Vector3d b = nodes_m[robot_.struts[s].node_b];
     const Eigen::Vector3d centre = 0.5 * (a + b);
-    const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a);
+    // Axis attachment keeps its historical orientation (results stay bit for bit);
+    // surface attachment needs the pose-following frame.
+    const Eigen::Quaterniond q =
+        surface_ ? Eigen::Quaterniond(strut_frame(nodes_m, robot_.struts[s].node_a, robot_.struts[s].node_b))
+                 : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a);
     dBodyID body = ode_->bodies[s];
     dBodySetPosition(body, centre.x(), centre.y(), centre.z());
     const dQuaternion dq = {q.w(), q.x(), q.y(), q.z()};
@@ -182,11 +191,25 @@ void Model::update_cable_geometry() {
   }
   for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
     const auto& cable = robot_.cables[m];
-    const Eigen::Vector3d d = node_pos_[cable.node_b] - node_pos_[cable.node_a];
-    const double length = d.norm();
+    Eigen::Vector3d d = node_pos_[cable.node_b] - node_pos_[cable.node_a];
+    Eigen::Vector3d dv = node_vel_[cable.node_b] - node_vel_[cable.node_a];
+    arm_a_[m] = node_arm_[cable.node_a];
+    arm_b_[m] = node_arm_[cable.node_b];
+    if (surface_) {
+      dBodyID body_a = ode_->bodies[strut_of_node_[cable.node_a]];
+      dBodyID body_b = ode_->bodies[strut_of_node_[cable.node_b]];
+      const Eigen::Vector3d off_a = rotation_of(dBodyGetRotation(body_a)) * local_a_[m];
+      const Eigen::Vector3d off_b = rotation_of(dBodyGetRotation(body_b)) * local_b_[m];
+      arm_a_[m] += off_a;
+      arm_b_[m] += off_b;
+      d += off_b - off_a;
+      dv += vec(dBodyGetAngularVel(body_b)).cross(off_b) - vec(dBodyGetAngularVel(body_a)).cross(off_a);
+    }
+    const double span = d.norm();
+    const double length = surface_ ? span + inner_run_m_[m] : span;
     length_m_[m] = length;
-    unit_[m] = length > 0.0 ? Eigen::Vector3d(d / length) : Eigen::Vector3d::Zero();
-    length_rate_m_per_s_[m] = (node_vel_[cable.node_b] - node_vel_[cable.node_a]).dot(unit_[m]);
+    unit_[m] = span > 0.0 ? Eigen::Vector3d(d / span) : Eigen::Vector3d::Zero();
+    length_rate_m_per_s_[m] = dv.dot(unit_[m]);
   }
 }
 
@@ -209,9 +232,9 @@ void Model::apply_forces() {
     const int sa = strut_of_node_[cable.node_a];
     const int sb = strut_of_node_[cable.node_b];
     force_[sa] += f;
-    torque_[sa] += node_arm_[cable.node_a].cross(f);
+    torque_[sa] += arm_a_[m].cross(f);
     force_[sb] -= f;
-    torque_[sb] -= node_arm_[cable.node_b].cross(f);
+    torque_[sb] -= arm_b_[m].cross(f);
   }
   for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
     dBodyID body = ode_->bodies[s];
@@ -227,6 +250,7 @@ void Model::apply_forces() {
 
 void Model::add_ground_contacts() {
   contact_count_ = 0;
+  ground_mask_ = 0;
   if (!ground_enabled_) return;
   // A capsule meets a plane only with its end spheres, so two sphere tests per strut
   // replace ODE's broad phase (which is also not thread-safe in Debian's build).
@@ -256,6 +280,7 @@ void Model::add_ground_contacts() {
     dJointID joint = dJointCreateContact(ode_->world, ode_->contacts, &contact);
     dJointAttach(joint, ode_->bodies[strut_of_node_[node]], nullptr);
     ++contact_count_;
+    ground_mask_ |= std::uint32_t{1} << node;
   }
 }
 
@@ -293,78 +318,6 @@ bool Model::forces_sane() const {
     const Eigen::Vector3d v = vec(dBodyGetLinearVel(ode_->bodies[s]));
     const Eigen::Vector3d w = vec(dBodyGetAngularVel(ode_->bodies[s]));
     if (!(v.squaredNorm() < kMaxSpeed * kMaxSpeed) || !(w.squaredNorm() < 1e2 * kMaxSpeed * kMaxSpeed)) return false;
-  }
-  return std::isfinite(sum);
-}
-
-Eigen::Vector3d Model::node_position(int node) const {
-  const int s = strut_of_node_[node];
-  dBodyID body = ode_->bodies[s];
-  return vec(dBodyGetPosition(body)) +
-         (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
-}
-
-std::vector<Eigen::Vector3d> Model::node_positions() const {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(node_pos_.size());
-  for (int i = 0; i < robot_.node_count(); ++i) out.push_back(node_position(i));
-  return out;
-}
-
-Eigen::Vector3d Model::centre_m() const {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (int i = 0; i < robot_.node_count(); ++i) sum += node_position(i);
-  return sum / robot_.node_count();
-}
-
-double Model::kinetic_energy_j() const {
-  double e = 0.0;
-  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
-    dBodyID body = ode_->bodies[s];
-    const Eigen::Vector3d v = vec(dBodyGetLinearVel(body));
-    dVector3 wb;
-    const dReal* w = dBodyGetAngularVel(body);
-    dBodyVectorFromWorld(body, w[0], w[1], w[2], wb);
-    const Eigen::Vector3d& I = ode_->inertia_diag[s];
-    e += 0.5 * robot_.strut_mass_kg * v.squaredNorm() +
-         0.5 * (I.x() * wb[0] * wb[0] + I.y() * wb[1] * wb[1] + I.z() * wb[2] * wb[2]);
-  }
-  return e;
-}
-
-double Model::gravity_energy_j() const {
-  double e = 0.0;
-  for (dBodyID body : ode_->bodies) e += robot_.strut_mass_kg * robot_.gravity_m_per_s2 * dBodyGetPosition(body)[2];
-  return e;
-}
-
-double Model::elastic_energy_j() const {
-  double e = 0.0;
-  for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
-    const Eigen::Vector3d d = node_position(robot_.cables[m].node_b) - node_position(robot_.cables[m].node_a);
-    const double stretch = d.norm() - rest_length_m_[m];
-    if (stretch > 0.0) e += 0.5 * robot_.cables[m].stiffness_n_per_m * stretch * stretch;
-  }
-  return e;
-}
-
-double Model::axial_spin_rad_per_s(int strut) const {
-  dBodyID body = ode_->bodies[strut];
-  return vec(dBodyGetAngularVel(body)).dot(axis_of(dBodyGetRotation(body)));
-}
-
-void Model::set_velocity(int strut, const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
-  dBodySetLinearVel(ode_->bodies[strut], v.x(), v.y(), v.z());
-  dBodySetAngularVel(ode_->bodies[strut], w.x(), w.y(), w.z());
-}
-
-bool Model::state_finite() const {
-  double sum = 0.0;
-  for (dBodyID body : ode_->bodies) {
-    const dReal* p = dBodyGetPosition(body);
-    const dReal* v = dBodyGetLinearVel(body);
-    const dReal* w = dBodyGetAngularVel(body);
-    sum += p[0] + p[1] + p[2] + v[0] + v[1] + v[2] + w[0] + w[1] + w[2];
   }
   return std::isfinite(sum);
 }

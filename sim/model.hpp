@@ -3,6 +3,7 @@
 // The robot in ODE: struts as capsule bodies, cables as one-sided spring-dampers
 // between strut end points whose rest lengths motors drive, a ground plane.
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -67,6 +68,8 @@ class Model {
   // The integration blew up (non-finite or absurd speeds); the model stops stepping.
   bool diverged() const { return diverged_; }
   int contact_count() const { return contact_count_; }
+  // End caps in contact with the ground in the last step, bit `node` set.
+  std::uint32_t ground_contact_mask() const { return ground_mask_; }
 
   // Switches for the energy-conservation test; defaults follow the robot.
   void set_gravity_enabled(bool on);
@@ -78,6 +81,8 @@ class Model {
   void update_cable_geometry();
   void apply_forces();
   void add_ground_contacts();
+  // Surface attachment: body-frame offsets of every cable end from its end cap centre.
+  void init_surface_attachments();
   bool forces_sane() const;
 
   Robot robot_;
@@ -92,6 +97,15 @@ class Model {
   // Per node: world position, velocity, and arm from its strut's centre; per cable
   // the unit vector from node a to node b.
   std::vector<Eigen::Vector3d> node_pos_, node_vel_, node_arm_, unit_, force_, torque_;
+  // Per cable: each end's arm from its strut's centre (the node's arm when cables
+  // attach on the axis) and, for surface attachment, its body-frame offset.
+  std::vector<Eigen::Vector3d> arm_a_, arm_b_, local_a_, local_b_;
+  // Surface attachment: the cable's run inside its two end caps (spool at the centre
+  // to the eyelet on the surface), so that in the description's pose a cable is as
+  // long as between end-cap centres and rest lengths keep their meaning.
+  std::vector<double> inner_run_m_;
+  bool surface_ = false;
+  std::uint32_t ground_mask_ = 0;
   bool ground_enabled_ = true;
   bool damping_enabled_ = true;
   int contact_count_ = 0;

@@ -34,6 +34,23 @@ long long integer(const json& v, const std::string& source, const std::string& f
   return v.get<long long>();
 }
 
+// provenance.gait: what the scoring episode saw of the struts' spin and the ground.
+void read_gait(const json& provenance, const Robot& robot, const std::string& source, Provenance& pr) {
+  const auto g = provenance.find("gait");
+  if (g == provenance.end()) return;
+  if (!g->is_object()) fail(source, "provenance.gait", "must be an object");
+  pr.axial_spin_rms_rad_per_s =
+      finite_number(g->value("axial_spin_rms_rad_per_s", json()), source, "provenance.gait.axial_spin_rms_rad_per_s");
+  pr.axial_spin_max_rad_per_s =
+      finite_number(g->value("axial_spin_max_rad_per_s", json()), source, "provenance.gait.axial_spin_max_rad_per_s");
+  const long long touched =
+      integer(g->value("endcaps_touched_ground", json()), source, "provenance.gait.endcaps_touched_ground");
+  if (touched < 0 || touched > robot.node_count()) {
+    fail(source, "provenance.gait.endcaps_touched_ground", "must be within 0.." + std::to_string(robot.node_count()));
+  }
+  pr.endcaps_touched_ground = static_cast<int>(touched);
+}
+
 }  // namespace
 
 Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source) {
@@ -115,6 +132,12 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
     if (const auto m = p.find("mutation"); m != p.end()) {
       if (!m->is_object()) fail(source, "provenance.mutation", "must be an object");
       Provenance& pr = policy.provenance;
+      // Policies from before the author's operator existed were bred by the Gaussian one.
+      const json op = m->value("operator", json("gaussian"));
+      if (!op.is_string() || (op != "gaussian" && op != "author")) {
+        fail(source, "provenance.mutation.operator", "must be \"gaussian\" or \"author\"");
+      }
+      pr.mutation = op.get<std::string>();
       pr.sigma_m = finite_number(m->value("sigma_m", json()), source, "provenance.mutation.sigma_m");
       pr.sigma_final_m = finite_number(m->value("sigma_final_m", json()), source, "provenance.mutation.sigma_final_m");
       pr.anneal_episodes = integer(m->value("anneal_episodes", json()), source, "provenance.mutation.anneal_episodes");
@@ -125,6 +148,7 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
       }
     }
   }
+  if (const auto it = doc.find("provenance"); it != doc.end()) read_gait(*it, robot, source, policy.provenance);
   return policy;
 }
 
@@ -175,8 +199,13 @@ std::string policy_to_json(const Policy& policy) {
   const Provenance& pr = policy.provenance;
   if (pr.sigma_m > 0.0) {
     doc["provenance"]["mutation"] = {
-        {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_start_episodes", pr.anneal_start_episodes},
+        {"operator", pr.mutation}, {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_start_episodes", pr.anneal_start_episodes},
         {"anneal_episodes", pr.anneal_episodes}};
+  }
+  if (pr.endcaps_touched_ground >= 0) {
+    doc["provenance"]["gait"] = {{"axial_spin_rms_rad_per_s", pr.axial_spin_rms_rad_per_s},
+                                 {"axial_spin_max_rad_per_s", pr.axial_spin_max_rad_per_s},
+                                 {"endcaps_touched_ground", pr.endcaps_touched_ground}};
   }
   return doc.dump(2) + "\n";
 }

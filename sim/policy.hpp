@@ -33,10 +33,16 @@ struct Provenance {
   std::string created_by = "tensegrity";
   // The mutation step the coevolution bred with (its schedule: docs/evolve.md), so that
   // method + seed + episodes + this reproduce the policy. sigma_m 0: not recorded.
+  std::string mutation = "gaussian";  // the operator: gaussian | author
   double sigma_m = 0.0;
   double sigma_final_m = 0.0;
   std::int64_t anneal_start_episodes = 0;
   std::int64_t anneal_episodes = 0;
+  // How the policy's struts turned in the episode that scored it (sim::EpisodeResult):
+  // a gait must roll, not skate on spinning struts. endcaps_touched_ground -1: not recorded.
+  double axial_spin_rms_rad_per_s = 0.0;
+  double axial_spin_max_rad_per_s = 0.0;
+  int endcaps_touched_ground = -1;
 };
 
 struct Policy {

@@ -117,6 +117,22 @@ std::vector<int> Robot::cables_of(int endcap) const {
   return out;
 }
 
+// The fields that decide how struts turn about their own axes (docs/model.md), read
+// apart so that robot files without them keep their behaviour.
+static void parse_spin_fields(const Reader& r, Robot& robot) {
+  const Reader strut = r.child("strut");
+  if (strut.has("cable_attachment")) {
+    const std::string where = strut.string("cable_attachment");
+    if (where == "axis") {
+      robot.cable_attachment = CableAttachment::axis;
+    } else if (where == "surface") {
+      robot.cable_attachment = CableAttachment::surface;
+    } else {
+      strut.fail("cable_attachment", "must be \"axis\" or \"surface\" (got \"" + where + "\")");
+    }
+  }
+}
+
 Robot parse_robot(const std::string& json_text, const std::string& source) {
   json doc;
   try {
@@ -227,6 +243,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   const Reader start = r.child("start");
   robot.start_clearance_m = start.non_negative("clearance_m");
   robot.settle_s = start.non_negative("settle_s");
+
+  parse_spin_fields(r, robot);
 
   robot.hash = fnv1a64_hex(doc.dump());
   return robot;

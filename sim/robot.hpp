@@ -30,6 +30,12 @@ struct StrutSpec {
   int node_b = 0;
 };
 
+// Where cables pull on a strut: `axis`, at the end-cap centre on the strut's axis
+// (no cable can turn a strut about its own axis); `surface`, on the end cap's
+// surface, radius_m off the axis toward the cable's other end, as on the hardware
+// and in NTRT (tgRodInfo::getConnectionPoint), so cable forces resist axial spin.
+enum class CableAttachment { axis, surface };
+
 struct Robot {
   std::string name;
   std::vector<Eigen::Vector3d> nodes_m;
@@ -40,6 +46,7 @@ struct Robot {
   // Viscous damping of a strut's spin about its own axis (see docs/model.md): the
   // cable attachments at real end caps resist it; point-attached cables cannot.
   double axial_damping_n_m_s = 0.0;
+  CableAttachment cable_attachment = CableAttachment::axis;  // strut.cable_attachment
   double initial_rest_length_m = 0.0;
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;

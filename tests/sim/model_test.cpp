@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 
 #include "sim/controller.hpp"
 #include "sim/episode.hpp"
@@ -130,6 +132,96 @@ TEST(Model, StrutCannotWheelAboutItsOwnAxis) {
   EXPECT_LT(moved, 0.02);
   // Without the cure the spin persists: this test can tell the two apart.
   EXPECT_GT(spin_free, 5.0);
+}
+
+Robot physical_spin(Robot robot) {
+  robot.axial_damping_n_m_s = 0.0;
+  robot.cable_attachment = CableAttachment::surface;
+  robot.hash += "-surface";  // the settled start is cached by hash
+  return robot;
+}
+
+// One strut of the settled robot spun at w0 about its own axis. Cables anchored on
+// the end caps' surfaces make a torsion spring: a cable of tension T whose anchor,
+// r off the axis, points along the part b of the cable's direction normal to the
+// axis resists a twist theta with T r b sin(theta). With k = sum of T r b over the
+// strut's 8 cable ends and I its axial inertia, energy bounds the twist by
+// theta_max = w0 sqrt(I / k) whatever the damping; a strut on the axis has k = 0 and
+// turns without bound. The twist must stay within theta_max (+25 % for the sine and
+// for neighbours that give way). Nothing in the model damps that spring but the
+// ground: a strut with an end cap on the ground must stop within 0.5 s; one in the
+// air keeps a bounded torsional oscillation (its spin never exceeds w0).
+TEST(Model, SurfaceAttachedCablesStopAStrutsSpin) {
+  const Robot robot = physical_spin(superball());
+  const std::vector<double> hold(24, robot.initial_rest_length_m);
+  constexpr double kSpin = 30.0;
+  int grounded_struts = 0;
+  for (int s = 0; s < 6; ++s) {
+    Model model(robot, robot.time_step_s);
+    model.restore(settled_state(robot, robot.time_step_s));
+    const auto& strut = robot.struts[s];
+    const Eigen::Vector3d a = model.node_position(strut.node_a);
+    const Eigen::Vector3d b = model.node_position(strut.node_b);
+    const Eigen::Vector3d axis = (b - a).normalized();
+    double k = 0.0;
+    for (int m = 0; m < robot.cable_count(); ++m) {
+      const auto& c = robot.cables[m];
+      for (const auto& [end, other] : {std::pair{c.node_a, c.node_b}, std::pair{c.node_b, c.node_a}}) {
+        if (end != strut.node_a && end != strut.node_b) continue;
+        const Eigen::Vector3d u = (model.node_position(other) - model.node_position(end)).normalized();
+        k += model.tension_n()[m] * robot.strut_radius_m * (u - u.dot(axis) * axis).norm();
+      }
+    }
+    // A capsule's axial inertia: its cylinder's m r^2 / 2 and its end spheres' 2 m r^2 / 5.
+    const double r = robot.strut_radius_m;
+    const double cylinder = M_PI * r * r * (b - a).norm(), spheres = 4.0 / 3.0 * M_PI * r * r * r;
+    const double m = robot.strut_mass_kg;
+    const double inertia = (m * cylinder / (cylinder + spheres)) * r * r / 2.0 +
+                           (m * spheres / (cylinder + spheres)) * 2.0 * r * r / 5.0;
+    const double theta_max = kSpin * std::sqrt(inertia / k);
+    model.step(hold);
+    const std::uint32_t ends = (std::uint32_t{1} << strut.node_a) | (std::uint32_t{1} << strut.node_b);
+    const bool grounded = (model.ground_contact_mask() & ends) != 0;
+    grounded_struts += grounded ? 1 : 0;
+    model.set_velocity(s, Eigen::Vector3d::Zero(), kSpin * axis);
+    double theta = 0.0, worst_theta = 0.0, late_spin = 0.0;
+    for (int ms = 0; ms < 1000; ++ms) {
+      run(model, 0.001, hold);
+      theta += model.axial_spin_rad_per_s(s) * 0.001;
+      worst_theta = std::max(worst_theta, std::fabs(theta));
+      if (ms >= 500) late_spin = std::max(late_spin, std::fabs(model.axial_spin_rad_per_s(s)));
+    }
+    EXPECT_LT(worst_theta, 1.25 * theta_max) << "strut " << s << ": twisted " << worst_theta << " rad";
+    if (grounded) {
+      EXPECT_LT(late_spin, 0.05 * kSpin) << "strut " << s << " still spins after 0.5 s";
+    } else {
+      EXPECT_LT(late_spin, 1.05 * kSpin) << "strut " << s << " gained energy";
+    }
+    std::printf("strut %d (%s): k %.2f N m/rad, theta_max %.3f rad, twist %.3f rad, spin after 0.5 s %.3f rad/s\n", s,
+                grounded ? "on the ground" : "in the air", k, theta_max, worst_theta, late_spin);
+  }
+  EXPECT_GE(grounded_struts, 2);  // the settled robot stands on three end caps
+}
+
+// The anchors move r off the axis, but a cable's run inside its end caps is counted,
+// so the settled robot keeps its tensions.
+TEST(Model, SurfaceAttachmentKeepsTheSettledTensions) {
+  for (const char* name : {"superball", "superball-ntrt2014"}) {
+    const Robot today = load_robot(robot_path_named(name));
+    const Robot surface = physical_spin(today);
+    const auto a = settled_state(today, today.time_step_s).tension_n;
+    const auto b = settled_state(surface, surface.time_step_s).tension_n;
+    ASSERT_EQ(a.size(), b.size());
+    double mean_a = 0.0, mean_b = 0.0;
+    for (std::size_t m = 0; m < a.size(); ++m) {
+      mean_a += a[m] / static_cast<double>(a.size());
+      mean_b += b[m] / static_cast<double>(b.size());
+    }
+    EXPECT_NEAR(mean_b, mean_a, 0.02 * mean_a) << name;
+    // Cable by cable within 3 % of the mean tension: the lightly loaded cables of the
+    // triangle on the ground gain about 1-2 N of their 22-43 N.
+    for (std::size_t m = 0; m < a.size(); ++m) EXPECT_NEAR(b[m], a[m], 0.03 * mean_a) << name << " cable " << m;
+  }
 }
 
 TEST(Model, SaveRestoreRoundTrips) {

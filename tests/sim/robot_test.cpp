@@ -133,6 +133,22 @@ TEST(Robot, OtherBadFieldsNamed) {
   }
 }
 
+TEST(Robot, SpinFieldsAreOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(plain.cable_attachment, CableAttachment::axis);
+  doc["strut"]["cable_attachment"] = "surface";
+  const Robot spun = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(spun.cable_attachment, CableAttachment::surface);
+  EXPECT_NE(spun.hash, plain.hash);
+  doc["strut"]["cable_attachment"] = "rim";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.cable_attachment: must be \"axis\" or \"surface\""));
+  doc["strut"]["cable_attachment"] = 1;
+  EXPECT_THAT(error_of(doc), HasSubstr("strut.cable_attachment: must be a string"));
+  doc["strut"]["cable_attachment"] = "axis";
+  EXPECT_EQ(parse_robot(doc.dump(), "test.json").cable_attachment, CableAttachment::axis);
+}
+
 TEST(Robot, MissingFileIsAClearError) {
   try {
     load_robot("/nonexistent/robot.json");
