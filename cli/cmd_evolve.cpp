@@ -18,6 +18,8 @@
 #include "cli/evolve_progress.hpp"
 #include "sim/evolve/checkpoint.hpp"
 #include "sim/evolve/driver.hpp"
+#include "sim/core_controller.hpp"
+#include "sim/episode.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
 
 namespace tensegrity::cli {
@@ -36,7 +38,8 @@ struct EvolveArgs {
   int population = 10;
   int teams = 50;
   int replace = 5;
-  double sigma_m = 0.05;
+  std::string mutation = "gaussian";
+  double sigma_m = -1.0;        // not given: the operator's own step (below)
   double sigma_final_m = -1.0;  // not given: sigma_m
   std::int64_t anneal_episodes = 0;
   std::int64_t anneal_start_episodes = 0;
@@ -88,8 +91,15 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   config.population = args.population;
   config.teams = args.teams;
   config.replace = args.replace;
-  config.sigma_m = args.sigma_m;
-  config.sigma_final_m = args.sigma_final_m < 0.0 ? args.sigma_m : args.sigma_final_m;
+  config.mutation = sim::evolve::parse_mutation(args.mutation);
+  sim::evolve::set_robot(config, robot);
+  // Each operator's own step: 0.05 m for the Gaussian (a tenth of the 0.5 m range),
+  // 0.03 of the range for the author's (NTRT's NeuroEvoMember::mutate).
+  const double range_m = config.max_rest_length_m - config.min_rest_length_m;
+  const double default_sigma_m =
+      config.mutation == sim::evolve::Mutation::author ? sim::evolve::kAuthorSigmaShareOfRange * range_m : 0.05;
+  config.sigma_m = args.sigma_m < 0.0 ? default_sigma_m : args.sigma_m;
+  config.sigma_final_m = args.sigma_final_m < 0.0 ? config.sigma_m : args.sigma_final_m;
   config.anneal_episodes = args.anneal_episodes;
   config.anneal_start_episodes = args.anneal_start_episodes;
   config.seed = args.seed;
@@ -97,7 +107,6 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   config.complexity = args.complexity;
   config.period_s = args.period_s;
   config.duration_s = args.duration_s;
-  sim::evolve::set_robot(config, robot);
   try {
     sim::evolve::validate(config);
   } catch (const sim::evolve::ConfigError& e) {
@@ -150,10 +159,22 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   policy.provenance.episodes = evo.episodes();
   policy.provenance.score_m = final_result.score_m;
   policy.provenance.robot_hash = robot.hash;
+  policy.provenance.mutation = sim::evolve::to_string(config.mutation);
   policy.provenance.sigma_m = config.sigma_m;
   policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
   policy.provenance.anneal_episodes = config.anneal_episodes;
   policy.provenance.anneal_start_episodes = config.anneal_episodes > 0 ? config.anneal_start_episodes : 0;
+  // The gait's strut spin and ground contacts, from one more episode of the policy
+  // through the control core: every learned gait reports whether it rolls or skates.
+  const sim::EpisodeResult gait = [&] {
+    sim::CoreController controller(robot, policy);
+    sim::EpisodeOptions episode;
+    episode.duration_s = config.duration_s;
+    return sim::run_episode(robot, controller, episode);
+  }();
+  policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
+  policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
+  policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
   sim::save_policy(args.out, policy);
 
   const std::int64_t episodes_here = evo.episodes() - result.resumed_episodes;
@@ -174,7 +195,11 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
                               {"episodes_per_s", rate},
                               {"out", args.out},
                               {"log", args.log},
-                              {"config", sim::evolve::config_to_json(config)}};
+                              {"config", sim::evolve::config_to_json(config)},
+                              {"gait",
+                               {{"axial_spin_rms_rad_per_s", gait.axial_spin_rms_rad_per_s},
+                                {"axial_spin_max_rad_per_s", gait.axial_spin_max_rad_per_s},
+                                {"endcaps_touched_ground", gait.endcaps_touched_ground}}}};
     if (mpi != nullptr) j["rank_loads"] = mpi->loads();
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -183,6 +208,8 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
     std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
                 final_result.score_m, final_result.feasible ? "" : " INFEASIBLE");
     std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
+    std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
+                gait.axial_spin_rms_rad_per_s, gait.axial_spin_max_rad_per_s, gait.endcaps_touched_ground);
     std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", wall_s, rate, threads);
     if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
     std::printf("\n");
@@ -220,7 +247,15 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--population", args->population, "Members per cable population")->capture_default_str()->check(CLI::Range(2, 100000));
   cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
   cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
-  cmd->add_option("--sigma", args->sigma_m, "Mutation step, metres (Gaussian, clamped to the limits)")->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--mutation", args->mutation,
+                  "Mutation operator: gaussian (every value of a copy) or author (NTRT's: half the copies, half "
+                  "their values)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"author", "gaussian"}));
+  cmd->add_option("--sigma", args->sigma_m,
+                  "Mutation step, metres, clamped to the limits (default: 0.05 for gaussian, 0.03 of the "
+                  "rest-length range for author)")
+      ->check(CLI::Range(0.0, 10.0));
   // The schedule's three options go together: a step given without its episodes
   // (or the reverse) would be silently ignored.
   CLI::Option* sigma_final = cmd->add_option("--sigma-final", args->sigma_final_m,

@@ -24,6 +24,9 @@ nlohmann::json episode_json(const sim::EpisodeResult& r) {
       {"mean_tension_n", r.mean_tension_n},
       {"motor_energy_j", r.motor_energy_j},
       {"mean_motor_power_w", r.mean_motor_power_w},
+      {"axial_spin_rms_rad_per_s", r.axial_spin_rms_rad_per_s},
+      {"axial_spin_max_rad_per_s", r.axial_spin_max_rad_per_s},
+      {"endcaps_touched_ground", r.endcaps_touched_ground},
       {"steps", r.steps},
       {"sim_time_s", r.sim_time_s},
       {"wall_time_s", r.wall_time_s},
@@ -40,6 +43,8 @@ void print_episode_summary(const sim::EpisodeResult& r) {
   }
   std::printf("  tension        mean %.1f N, max %.1f N\n", r.mean_tension_n, r.max_tension_n);
   std::printf("  motors         %.1f J, %.2f W per cable on average\n", r.motor_energy_j, r.mean_motor_power_w);
+  std::printf("  strut spin     %.2f rad/s RMS, %.2f max about their axes; %d end caps touched the ground\n",
+              r.axial_spin_rms_rad_per_s, r.axial_spin_max_rad_per_s, r.endcaps_touched_ground);
   std::printf("  time           %.2f s simulated in %.3f s wall (%.0fx real time)\n", r.sim_time_s,
               r.wall_time_s, r.real_time_factor());
 }

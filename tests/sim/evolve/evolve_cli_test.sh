@@ -30,7 +30,8 @@ sched=(--sigma 0.05 --sigma-final 0.01 --anneal-start 4 --anneal-episodes 8)
 import json, sys
 w = sys.argv[1]
 m = json.load(open(f"{w}/p.json"))["provenance"]["mutation"]
-assert m == {"sigma_m": 0.05, "sigma_final_m": 0.01, "anneal_start_episodes": 4, "anneal_episodes": 8}, m
+assert m == {"operator": "gaussian", "sigma_m": 0.05, "sigma_final_m": 0.01, "anneal_start_episodes": 4,
+             "anneal_episodes": 8}, m
 c = json.load(open(f"{w}/summary.json"))["config"]
 assert (c["sigma_final_m"], c["anneal_start_episodes"], c["anneal_episodes"]) == (0.01, 4, 8), c
 PY
@@ -42,4 +43,23 @@ if "$tensegrity" evolve "${small[@]}" --sigma 0.05 --sigma-final 0.01 --anneal-s
   fail "a resume under another schedule was accepted"
 fi
 grep -q "anneal_start_episodes: 4 -> 6" "$work/out" || fail "the refusal does not name the field: $(cat "$work/out")"
+# The author's operator: its own default step (0.03 of the 0.5 m range), recorded in
+# the config, the provenance and the summary, with the gait's strut spin; another
+# operator on --resume is another run.
+"$tensegrity" evolve "${small[@]}" --mutation author --episodes 8 --checkpoint "$work/ack" \
+  --out "$work/a.json" --log "$work/a.csv" --json > "$work/asummary.json"
+/usr/bin/python3 - "$work" <<'PY' || fail "the author's operator is not recorded"
+import json, sys
+w = sys.argv[1]
+p = json.load(open(f"{w}/a.json"))["provenance"]
+assert p["mutation"]["operator"] == "author" and abs(p["mutation"]["sigma_m"] - 0.015) < 1e-12, p
+assert 0 <= p["gait"]["endcaps_touched_ground"] <= 12 and p["gait"]["axial_spin_max_rad_per_s"] >= 0, p
+s = json.load(open(f"{w}/asummary.json"))
+assert s["config"]["mutation"] == "author" and s["gait"] == p["gait"], s
+PY
+if "$tensegrity" evolve "${small[@]}" --mutation gaussian --sigma 0.015 --episodes 16 --checkpoint "$work/ack" \
+    --resume --out "$work/a2.json" --log "$work/a2.csv" > "$work/out" 2>&1; then
+  fail "a resume under another operator was accepted"
+fi
+grep -q 'mutation: "author" -> "gaussian"' "$work/out" || fail "the refusal does not name the operator: $(cat "$work/out")"
 echo "PASS"

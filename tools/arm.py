@@ -1,0 +1,263 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
+"""Run one arm of a controlled comparison: N seeds of `tensegrity evolve` with the
+same settings, and summarise them.
+
+An arm is a robot file (optionally changed by --set), evolve options and a seed
+range. Each seed runs in OUT/runs/sK/ with a checkpoint after every generation,
+so the script can be stopped and started again: finished seeds are reused,
+unfinished ones resume. Seeds run --jobs at a time under `nice`.
+
+Summary (OUT/arm.json, OUT/arm.csv, OUT/arm.png), at every --at budget:
+best team so far per seed, median and quartiles over seeds, seeds >= 28 m and
+>= 32 m, the episode of each seed's first team >= 32 m, the generation mean
+(last 5 generations before the budget), the infeasible share of the first 10
+generations.
+
+Examples:
+  tools/arm.py --out out/arms/gauss-d005 --robot robots/superball-ntrt2014.json \\
+      --set time_step_s=0.002 --seeds 10 --episodes 1000 -- --mutation gaussian
+  tools/arm.py --compare out/arms/A out/arms/B --out out/arms/compare --at 1000
+"""
+import argparse
+import concurrent.futures
+import csv
+import json
+import os
+import pathlib
+import statistics
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+TARGET_M = 32.0
+NEAR_M = 28.0
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", required=True, help="arm directory (or the comparison's, with --compare)")
+    p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
+    p.add_argument("--robot", default=str(ROOT / "robots/superball-ntrt2014.json"), help="robot description")
+    p.add_argument("--set", action="append", default=[], metavar="PATH=JSON",
+                   help="change a robot field, e.g. strut.axial_damping_n_m_s=0.05 (repeatable)")
+    p.add_argument("--seeds", type=int, default=10, help="seeds per arm (default: %(default)s)")
+    p.add_argument("--first-seed", type=int, default=1)
+    p.add_argument("--episodes", type=int, default=1000, help="episode budget per seed (default: %(default)s)")
+    p.add_argument("--jobs", type=int, default=2, help="seeds at a time (default: %(default)s)")
+    p.add_argument("--threads", type=int, default=1, help="evolve --threads per seed (default: %(default)s)")
+    p.add_argument("--nice", type=int, default=10, help="niceness of the runs (default: %(default)s)")
+    p.add_argument("--at", type=int, action="append", default=None,
+                   help="budgets to summarise at (default: 1000, 2500, 5000 up to --episodes)")
+    p.add_argument("--summary-only", action="store_true", help="summarise the runs there, run nothing")
+    p.add_argument("--compare", nargs="+", metavar="ARM_DIR", help="compare finished arms instead of running one")
+    p.add_argument("evolve_args", nargs="*", help="more `tensegrity evolve` options (after --)")
+    return p.parse_args()
+
+
+def set_field(doc, path, value_text):
+    keys = path.split(".")
+    node = doc
+    for k in keys[:-1]:
+        node = node.setdefault(k, {})
+    node[keys[-1]] = json.loads(value_text)
+
+
+def write_robot(args, out):
+    doc = json.loads(pathlib.Path(args.robot).read_text())
+    for item in args.set:
+        if "=" not in item:
+            sys.exit(f"--set {item}: expected PATH=JSON")
+        path, value = item.split("=", 1)
+        set_field(doc, path, value)
+    robot = out / "robot.json"
+    text = json.dumps(doc, indent=2) + "\n"
+    if not robot.exists() or robot.read_text() != text:
+        robot.write_text(text)
+    return robot
+
+
+def run_seed(args, robot, seed):
+    run = pathlib.Path(args.out) / "runs" / f"s{seed}"
+    run.mkdir(parents=True, exist_ok=True)
+    summary = run / "summary.json"
+    if summary.exists() and json.loads(summary.read_text()).get("episodes", 0) >= args.episodes:
+        return seed, "reused"
+    cmd = ["nice", "-n", str(args.nice), args.tensegrity, "evolve", "--robot", str(robot),
+           "--episodes", str(args.episodes), "--seed", str(seed), "--threads", str(args.threads),
+           "--checkpoint", str(run / "ckpt"), "--resume", "--out", str(run / "policy.json"),
+           "--log", str(run / "curve.csv"), "--json"] + args.evolve_args
+    with open(run / "stderr.log", "w") as err:
+        result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=err, text=True)
+    if result.returncode != 0:
+        return seed, f"FAILED ({result.returncode}), see {run / 'stderr.log'}"
+    summary.write_text(result.stdout)
+    (run / "command.txt").write_text(" ".join(cmd[3:]) + "\n")
+    return seed, "done"
+
+
+def read_curve(path):
+    with open(path) as f:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def seed_metrics(curve, budget):
+    rows = [r for r in curve if r["episodes"] <= budget]
+    if not rows:
+        return None
+    first32 = next((int(r["episodes"]) for r in curve if r["best_so_far_m"] >= TARGET_M), None)
+    early = curve[:10]
+    return {
+        "best_m": rows[-1]["best_so_far_m"],
+        "generation_mean_m": statistics.fmean(r["mean_score_m"] for r in rows[-5:]),
+        "first_episode_32m": first32 if first32 is not None and first32 <= budget else None,
+        "infeasible_first10": sum(r["infeasible"] for r in early) / max(1.0, sum(r["teams"] for r in early)),
+        "episodes": int(rows[-1]["episodes"]),
+    }
+
+
+def quartiles(values):
+    if len(values) < 2:
+        return (values[0], values[0], values[0]) if values else (None, None, None)
+    q = statistics.quantiles(values, n=4, method="inclusive")
+    return q[0], statistics.median(values), q[2]
+
+
+def summarise_budget(per_seed, budget):
+    best = [m["best_m"] for m in per_seed.values()]
+    q1, med, q3 = quartiles(best)
+    firsts = [m["first_episode_32m"] for m in per_seed.values() if m["first_episode_32m"] is not None]
+    return {"budget": budget, "seeds": len(best), "median_m": med, "q1_m": q1, "q3_m": q3,
+            "mean_m": statistics.fmean(best) if best else None, "min_m": min(best, default=None),
+            "max_m": max(best, default=None), "seeds_ge_28": sum(b >= NEAR_M for b in best),
+            "seeds_ge_32": sum(b >= TARGET_M for b in best),
+            "first_episode_32m": min(firsts, default=None),
+            "generation_mean_median_m": statistics.median([m["generation_mean_m"] for m in per_seed.values()])
+            if best else None,
+            "infeasible_first10_mean": statistics.fmean([m["infeasible_first10"] for m in per_seed.values()])
+            if best else None}
+
+
+def budgets(args, episodes):
+    if args.at:
+        return sorted(set(args.at))
+    return [b for b in (500, 1000, 2500, 5000) if b <= episodes] or [episodes]
+
+
+def summarise_arm(out, args):
+    runs = sorted((out / "runs").glob("s*/curve.csv"), key=lambda p: int(p.parent.name[1:]))
+    curves = {int(p.parent.name[1:]): read_curve(p) for p in runs}
+    curves = {s: c for s, c in curves.items() if c}
+    episodes = max((int(c[-1]["episodes"]) for c in curves.values()), default=0)
+    result = {"arm": out.name, "command": (out / "command.txt").read_text().strip()
+              if (out / "command.txt").exists() else "", "at": []}
+    rows = []
+    for b in budgets(args, episodes):
+        per_seed = {s: m for s, c in curves.items() if (m := seed_metrics(c, b)) and m["episodes"] >= b}
+        if not per_seed:
+            continue
+        result["at"].append(summarise_budget(per_seed, b) | {"per_seed": per_seed})
+        for s, m in per_seed.items():
+            rows.append({"budget": b, "seed": s} | m)
+    (out / "arm.json").write_text(json.dumps(result, indent=2) + "\n")
+    with open(out / "arm.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=["budget", "seed", "episodes", "best_m", "generation_mean_m",
+                                          "first_episode_32m", "infeasible_first10"])
+        w.writeheader()
+        w.writerows(rows)
+    plot_arm(out, curves)
+    return result
+
+
+def plot_arm(out, curves):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for s, c in sorted(curves.items()):
+        ax.plot([r["episodes"] for r in c], [r["best_so_far_m"] for r in c], lw=0.8, alpha=0.6)
+    if curves:
+        n = min(len(c) for c in curves.values())
+        x = [curves[next(iter(curves))][i]["episodes"] for i in range(n)]
+        qs = [quartiles([c[i]["best_so_far_m"] for c in curves.values()]) for i in range(n)]
+        ax.fill_between(x, [q[0] for q in qs], [q[2] for q in qs], color="k", alpha=0.15, label="quartiles")
+        ax.plot(x, [q[1] for q in qs], "k", lw=2, label=f"median of {len(curves)} seeds")
+    ax.axhline(TARGET_M, color="r", ls="--", lw=1, label="paper: 32 m")
+    ax.set_xlabel("episodes")
+    ax.set_ylabel("best team so far, m in 60 s")
+    ax.set_title(out.name)
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "arm.png", dpi=110)
+    plt.close(fig)
+
+
+def compare(args):
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    dirs = [d for d in args.compare if (pathlib.Path(d) / "runs").is_dir()]
+    arms = [summarise_arm(pathlib.Path(d), args) | {"dir": d} for d in dirs]
+    rows = []
+    for arm in arms:
+        for at in arm["at"]:
+            rows.append({k: v for k, v in at.items() if k != "per_seed"} | {"arm": arm["arm"]})
+    (out / "compare.json").write_text(json.dumps(rows, indent=2) + "\n")
+    fields = ["arm", "budget", "seeds", "median_m", "q1_m", "q3_m", "mean_m", "min_m", "max_m", "seeds_ge_28",
+              "seeds_ge_32", "first_episode_32m", "generation_mean_median_m", "infeasible_first10_mean"]
+    with open(out / "compare.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    for r in rows:
+        print(f"{r['arm']:<28} {r['budget']:>5} ep  n={r['seeds']:<2} median {r['median_m']:6.2f} "
+              f"[{r['q1_m']:6.2f}, {r['q3_m']:6.2f}]  >=28: {r['seeds_ge_28']}  >=32: {r['seeds_ge_32']}  "
+              f"first32: {r['first_episode_32m']}  gen mean {r['generation_mean_median_m']:.2f}")
+    plot_compare(out, arms)
+
+
+def plot_compare(out, arms):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(max(6, 1.3 * len(arms)), 4.5))
+    data, labels = [], []
+    for arm in arms:
+        if arm["at"]:
+            last = arm["at"][-1]
+            data.append([m["best_m"] for m in last["per_seed"].values()])
+            labels.append(f"{arm['arm']}\n{last['budget']} ep, n={last['seeds']}")
+    if data:
+        ax.boxplot(data, labels=labels, showmeans=True)
+        for i, d in enumerate(data, start=1):
+            ax.scatter([i] * len(d), d, s=10, alpha=0.5)
+    ax.axhline(TARGET_M, color="r", ls="--", lw=1)
+    ax.set_ylabel("best team, m in 60 s")
+    ax.tick_params(axis="x", labelsize=7)
+    fig.tight_layout()
+    fig.savefig(out / "compare.png", dpi=110)
+    plt.close(fig)
+
+
+def main():
+    args = parse_args()
+    if args.compare:
+        compare(args)
+        return
+    out = pathlib.Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    robot = write_robot(args, out)
+    if not args.summary_only:
+        seeds = range(args.first_seed, args.first_seed + args.seeds)
+        (out / "command.txt").write_text(" ".join([sys.argv[0]] + sys.argv[1:]) + "\n")
+        with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+            for seed, status in pool.map(lambda s: run_seed(args, robot, s), seeds):
+                print(f"{out.name} seed {seed}: {status}", flush=True)
+    result = summarise_arm(out, args)
+    for at in result["at"]:
+        print(f"{out.name} at {at['budget']}: median {at['median_m']:.2f} m [{at['q1_m']:.2f}, {at['q3_m']:.2f}], "
+              f">=28 m {at['seeds_ge_28']}/{at['seeds']}, >=32 m {at['seeds_ge_32']}/{at['seeds']}, "
+              f"first 32 m at {at['first_episode_32m']}")
+
+
+if __name__ == "__main__":
+    main()
