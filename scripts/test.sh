@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # Builds everything and runs every test: the host build (ctest, which includes the
 # SocketCAN tests in a VM with a real kernel), then the firmware cross-built for the
-# end caps' ARMv7 boards with its tests under qemu-arm. The README's test command.
+# end caps' ARMv7 boards with its tests under qemu-arm, and the libFuzzer targets
+# (scripts/fuzz.sh). The README's test command.
 #   TENSEGRITY_TEST_PRESET=asan  host preset (default: default)
 #   TENSEGRITY_CROSS=none        skip the cross build (default: armhf; also aarch64)
 set -euo pipefail
@@ -15,6 +16,11 @@ cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" -j "$(nproc)"
 ctest --preset "$preset"
 echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
+# Every decoder of outside input under libFuzzer: corpora and recorded crashes
+# replayed, then 20 s of seeded fuzzing per target (docs/fuzzing.md).
+fuzz_start=$(date +%s)
+scripts/fuzz.sh 20
+echo "test: fuzzing took $(( $(date +%s) - fuzz_start )) s"
 for arch in ${TENSEGRITY_CROSS:-armhf}; do
   [[ "$arch" == none ]] && continue
   JOBS="$(nproc)" scripts/cross-test.sh "$arch"
