@@ -7,6 +7,7 @@
 # regression (fuzz/regressions/<target>/, docs/fuzzing.md).
 #   scripts/fuzz.sh [SECONDS=20] [TARGET...]     (default: every target)
 #   FUZZ_RUNS=N   stop each target after N executions instead (long runs)
+#   FUZZ_SEED=N   libFuzzer seed (default 1: a CI run is reproducible)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
@@ -25,7 +26,7 @@ for t in "${targets[@]}"; do
   work="out/fuzz/$t"
   rm -rf "$work" && mkdir -p "$work/corpus"
   cp -r "fuzz/corpus/$t/." "$work/corpus/"
-  args=(-max_len=8192 -print_final_stats=1 -artifact_prefix="$work/")
+  args=(-seed="${FUZZ_SEED:-1}" -max_len=8192 -print_final_stats=1 -artifact_prefix="$work/")
   [[ -f "fuzz/dict/$t.dict" ]] && args+=(-dict="fuzz/dict/$t.dict")
   if [[ -n "${FUZZ_RUNS:-}" ]]; then args+=(-runs="$FUZZ_RUNS"); else args+=(-max_total_time="$seconds"); fi
   echo "fuzz: $t (${FUZZ_RUNS:+$FUZZ_RUNS runs}${FUZZ_RUNS:-$seconds s})"
