@@ -94,7 +94,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   json doc;
   try {
     doc = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw ConfigError(source + ": not valid JSON: " + e.what());
   }
   const Reader top(doc, source, "");

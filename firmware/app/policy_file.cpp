@@ -31,7 +31,7 @@ core::EndcapTable endcap_table_from_policy(const std::string& json_text, int end
   json doc;
   try {
     doc = json::parse(json_text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
     throw PolicyFileError(source + ": not valid JSON: " + e.what());
   }
   if (!doc.is_object()) fail(source, "(top level)", "must be an object");

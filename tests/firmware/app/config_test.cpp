@@ -140,7 +140,20 @@ TEST(PolicyFile, ErrorsNameTheField) {
               HasSubstr("cables: end cap 0 owns 0 cables"));
   EXPECT_THAT(error(R"({"format": "x"})", 0), HasSubstr("p.json: format"));
   EXPECT_THAT(error("{", 0), HasSubstr("not valid JSON"));
+  // Found by fuzz/policy_file: a number too large for a double is bad JSON too,
+  // not nlohmann's out_of_range escaping the documented error.
+  EXPECT_THAT(error(R"({"format": "tensegrity-policy/1", "period_s": 1e30808})", 0), HasSubstr("not valid JSON"));
 }
 
+}  // namespace
+}  // namespace tensegrity::fw::app
+
+namespace tensegrity::fw::app {
+namespace {
+// Found by fuzz/endcap_config: a number too large for a double escaped as
+// nlohmann's out_of_range instead of the documented ConfigError.
+TEST(EndcapConfig, ANumberTooLargeForADoubleIsAConfigError) {
+  EXPECT_THROW(parse_config(R"({"bus": "udp:127.0.0.1:1", "loop_rate_hz": 1e30808})", 3, "endcap.json"), ConfigError);
+}
 }  // namespace
 }  // namespace tensegrity::fw::app
