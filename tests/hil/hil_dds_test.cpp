@@ -31,7 +31,14 @@ TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
   o.dds_discovery_timeout_s = 3.0;
   const HilResult r = run_hil(o);
   ASSERT_FALSE(r.ok);
-  EXPECT_NE(r.error.find("no heartbeat from end cap(s) 7 "), std::string::npos) << r.error;
+  // End cap 7 and only it is named as silent. Within the short 3 s another end cap
+  // may also still be syncing its clock (named in a second clause, after a comma):
+  // that is not what this test is about, and under ctest it happened 2 runs in 3.
+  const std::string silent = "no heartbeat from end cap(s) 7";
+  const auto at = r.error.find(silent);
+  ASSERT_NE(at, std::string::npos) << r.error;
+  const char after = at + silent.size() < r.error.size() ? r.error[at + silent.size()] : ' ';
+  EXPECT_TRUE(after == ' ' || after == ',') << "another end cap named as silent: " << r.error;
   EXPECT_TRUE(child_pids().empty());
 }
 
