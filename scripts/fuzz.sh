@@ -29,12 +29,13 @@ for t in "${targets[@]}"; do
   args=(-seed="${FUZZ_SEED:-1}" -max_len=8192 -print_final_stats=1 -artifact_prefix="$work/")
   [[ -f "fuzz/dict/$t.dict" ]] && args+=(-dict="fuzz/dict/$t.dict")
   if [[ -n "${FUZZ_RUNS:-}" ]]; then args+=(-runs="$FUZZ_RUNS"); else args+=(-max_total_time="$seconds"); fi
-  echo "fuzz: $t (${FUZZ_RUNS:+$FUZZ_RUNS runs}${FUZZ_RUNS:-$seconds s})"
+  if [[ -n "${FUZZ_RUNS:-}" ]]; then budget="$FUZZ_RUNS runs"; else budget="$seconds s"; fi
+  echo "fuzz: $t ($budget)"
   if ! TENSEGRITY_SOURCE_DIR="$root" "$bin/fuzz_$t" "${args[@]}" "$work/corpus" >"$work/log.txt" 2>&1; then
     echo "fuzz: $t FAILED; input and log in $work/" >&2
     tail -n 40 "$work/log.txt" >&2
     status=1
   fi
-  grep -E '^stat::(number_of_executed_units|average_exec_per_sec|new_units_added)' "$work/log.txt" | sed "s/^/fuzz: $t /"
+  grep -E '^stat::(number_of_executed_units|average_exec_per_sec|new_units_added)' "$work/log.txt" | sed "s/^/fuzz: $t /" || true
 done
 exit $status
