@@ -163,45 +163,69 @@ void ControlLoop::handle_bring_up(std::int64_t time_ns) {
   }
 }
 
+// Counters the host link raises (emergency_stops, host_loss_stops): a change since
+// the last look is a stop to apply now.
+void ControlLoop::apply_host_stops(std::uint32_t estops, std::uint32_t host_loss_stops, std::int64_t time_ns) {
+  if (estops != estops_seen_) {
+    estops_seen_ = estops;
+    latch(FaultCause::emergency_stop, time_ns);
+  }
+  if (host_loss_stops != host_loss_stops_seen_) {
+    host_loss_stops_seen_ = host_loss_stops;
+    HostCommand stop;
+    stop.kind = CommandKind::stop;
+    apply_command(stop, time_ns);
+  }
+}
+
+void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns) {
+  switch (command.kind) {
+    case CommandKind::start:
+      if (command.start_time_ns > time_ns && drives_enabled() && controller_.has_table() &&
+          controller_.fault() == FaultCause::none) {
+        pending_start_ = true;
+        pending_start_ns_ = command.start_time_ns;
+      } else {
+        try_start(command.start_time_ns, time_ns);
+      }
+      break;
+    case CommandKind::stop:
+      pending_start_ = false;
+      if (controller_.mode() == core::Mode::running) emit(AppEventKind::stopped, time_ns);
+      controller_.stop();
+      break;
+    case CommandKind::emergency_stop: latch(FaultCause::emergency_stop, time_ns); break;
+    case CommandKind::clear_fault: {
+      if (controller_.fault() == FaultCause::none) break;
+      const FaultCause was = controller_.fault();
+      controller_.clear_fault();
+      hold_at_measured();
+      master_.request_fault_reset();
+      master_.request_power(PowerRequest::operation_enabled);
+      grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
+      // A node that rebooted while lost is pre-operational again: bring it up anew.
+      bool all_operational = master_.heartbeat(NodeRole::load_cell).state == NmtState::operational ||
+                             !settings_.master.use_load_cell;
+      for (std::size_t i = 0; i < master_.drive_count(); ++i) {
+        all_operational = all_operational && master_.drive_heartbeat(i).state == NmtState::operational;
+      }
+      if (!all_operational) bring_up_started_ = false;
+      emit(AppEventKind::fault_cleared, time_ns, was);
+      break;
+    }
+  }
+}
+
 void ControlLoop::handle_host(std::int64_t time_ns) {
   HostCommand command;
   while (host_.try_take_command(command)) {
-    switch (command.kind) {
-      case CommandKind::start:
-        if (command.start_time_ns > time_ns && drives_enabled() && controller_.has_table() &&
-            controller_.fault() == FaultCause::none) {
-          pending_start_ = true;
-          pending_start_ns_ = command.start_time_ns;
-        } else {
-          try_start(command.start_time_ns, time_ns);
-        }
-        break;
-      case CommandKind::stop:
-        pending_start_ = false;
-        if (controller_.mode() == core::Mode::running) emit(AppEventKind::stopped, time_ns);
-        controller_.stop();
-        break;
-      case CommandKind::emergency_stop: latch(FaultCause::emergency_stop, time_ns); break;
-      case CommandKind::clear_fault: {
-        if (controller_.fault() == FaultCause::none) break;
-        const FaultCause was = controller_.fault();
-        controller_.clear_fault();
-        hold_at_measured();
-        master_.request_fault_reset();
-        master_.request_power(PowerRequest::operation_enabled);
-        grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
-        // A node that rebooted while lost is pre-operational again: bring it up anew.
-        bool all_operational = master_.heartbeat(NodeRole::load_cell).state == NmtState::operational ||
-                               !settings_.master.use_load_cell;
-        for (std::size_t i = 0; i < master_.drive_count(); ++i) {
-          all_operational = all_operational && master_.drive_heartbeat(i).state == NmtState::operational;
-        }
-        if (!all_operational) bring_up_started_ = false;
-        emit(AppEventKind::fault_cleared, time_ns, was);
-        break;
-      }
+    // An estop sent before this command lands first (HostCommand::estops_before).
+    if (static_cast<std::int32_t>(command.estops_before - estops_seen_) > 0) {
+      apply_host_stops(command.estops_before, host_loss_stops_seen_, time_ns);
     }
+    apply_command(command, time_ns);
   }
+  apply_host_stops(host_.emergency_stops(), host_.host_loss_stops(), time_ns);
   if (pending_start_ && time_ns >= pending_start_ns_) {
     pending_start_ = false;
     try_start(pending_start_ns_, time_ns);
@@ -216,14 +240,16 @@ void ControlLoop::handle_host(std::int64_t time_ns) {
     e.time_ns = time_ns;
     e.table_error = error;
     events_.push(e);
-    // Persisting means fsync: the housekeeping thread does it, never this one.
-    if (error == core::TableError::none) persist_.write(incoming.table);
   }
 }
 
 void ControlLoop::drain_bus(std::int64_t time_ns) {
   CanFrame frame;
-  while (bus_.receive(frame, 0) == CanResult::ok) master_.on_frame(frame, time_ns);
+  for (int n = 0; n < kMaxFramesPerCycle; ++n) {
+    if (bus_.receive(frame, 0) != CanResult::ok) return;
+    master_.on_frame(frame, time_ns);
+  }
+  ++status_.drain_limited_cycles;  // frames may remain: the next cycle takes them
 }
 
 void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
