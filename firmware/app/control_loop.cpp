@@ -23,23 +23,6 @@ std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s *
 bool is_sync(const CanFrame& f) { return !f.extended && !f.rtr && f.id == canopen::kSyncCobId && f.dlc <= 1; }
 }  // namespace
 
-const char* to_string(AppEventKind kind) {
-  switch (kind) {
-    case AppEventKind::bring_up_done: return "bring-up done";
-    case AppEventKind::bring_up_failed: return "bring-up failed";
-    case AppEventKind::fault_latched: return "fault latched";
-    case AppEventKind::fault_cleared: return "fault cleared";
-    case AppEventKind::table_accepted: return "table accepted";
-    case AppEventKind::table_rejected: return "table rejected";
-    case AppEventKind::table_swapped: return "table swapped in";
-    case AppEventKind::started: return "started";
-    case AppEventKind::start_refused: return "start refused";
-    case AppEventKind::stopped: return "stopped";
-    case AppEventKind::master_event: return "CANopen";
-  }
-  return "unknown";
-}
-
 LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   LoopSettings s;
   s.core.motor_count = c.motor_count;

@@ -19,7 +19,7 @@
 
 #include "firmware/app/policy_store.hpp"
 #include "ground/upload.hpp"
-#include "hil/process_launcher.hpp"
+#include "firmware/hal/udp_can_bus.hpp"
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 #include "tests/ground/subprocess.hpp"
@@ -35,10 +35,16 @@ constexpr int kDomain = 158;
 constexpr int kTrials = 100;
 constexpr int kEndcap = 0;
 
+std::uint16_t free_udp_port() {
+  std::string error;
+  auto probe = fw::UdpCanBus::open({{"127.0.0.1", 9}, {"127.0.0.1", 0}}, error);
+  return probe ? probe->local_port() : 0;  // closed again here; the race is harmless on loopback
+}
+
 TEST(PersistenceKill, RebootsWithTheOldOrTheNewTableEachUnderItsOwnIdentity) {
   const fs::path dir = fs::temp_directory_path() / ("persistence_kill_" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const std::vector<std::uint16_t> ports = hil::free_udp_ports(2);
+  const std::vector<std::uint16_t> ports{free_udp_port(), 9};  // the bus's peer: nobody
   const json config = {
       {"format", "tensegrity-endcap/1"},
       {"bus", "udp:127.0.0.1:" + std::to_string(ports[1]) + ",bind=127.0.0.1:" + std::to_string(ports[0])},
