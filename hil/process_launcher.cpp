@@ -152,8 +152,9 @@ void ProcessLauncher::start_all() {
 
 void ProcessLauncher::spawn(int e, bool restart) {
   Slot& s = slots_[e];
+  // --hang-loop-signal: the hang_loop fault's test hook (SIGRTMIN), harmless unless sent.
   std::vector<std::string> args{config_.endcap_binary.string(), "--id", std::to_string(e), "--config", s.config.string(),
-                                "--stats-json", s.stats.string()};
+                                "--stats-json", s.stats.string(), "--hang-loop-signal"};
   for (auto& a : provisioner_.endcap_arguments(e, restart)) args.push_back(std::move(a));
   if (const auto extra = config_.extra_args.find(e); extra != config_.extra_args.end()) {
     args.insert(args.end(), extra->second.begin(), extra->second.end());
@@ -304,6 +305,16 @@ std::string ProcessLauncher::set_dds_link(int e, bool up) {
   if (s.pid <= 0) return "not running";
   const int signal = up ? SIGUSR2 : SIGUSR1;
   if (!catches(s.pid, signal)) return "its program does not handle the link signals (yet)";
+  if (::kill(s.pid, signal) != 0) return std::string("kill: ") + std::strerror(errno);
+  return "";
+}
+
+std::string ProcessLauncher::freeze(int e, bool loop_only) {
+  reap(e, false);
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) return "not running";
+  const int signal = loop_only ? SIGRTMIN : SIGSTOP;
+  if (loop_only && !catches(s.pid, signal)) return "its program does not handle the hang signal (yet)";
   if (::kill(s.pid, signal) != 0) return std::string("kill: ") + std::strerror(errno);
   return "";
 }

@@ -70,6 +70,8 @@ class ProcessLauncher final : public EndcapProcesses {
   void restart(int endcap) override;
   // SIGUSR1 (cut) / SIGUSR2 (restore) to a program started with --dds-cut-signals.
   std::string set_dds_link(int endcap, bool up) override;
+  // SIGSTOP, or SIGRTMIN to a program started with --hang-loop-signal (loop_only).
+  std::string freeze(int endcap, bool loop_only) override;
 
   // SIGTERM to every end cap, without waiting (so the emulator can keep serving
   // their buses while they stop); idempotent.
