@@ -102,6 +102,10 @@ class ProcessLauncher final : public EndcapProcesses {
   bool shut_down_ = false;
 };
 
+// The drives' consumer heartbeat time the launcher configures in real time (the
+// end cap's default, 50 ms, in lockstep).
+inline constexpr double kRealtimeConsumerHeartbeatS = 0.2;
+
 // Free UDP ports on 127.0.0.1 for the end caps' buses, from the kLauncherPortSpan
 // ports just below the kernel's ephemeral range (bound together, then released).
 inline constexpr int kLauncherPortSpan = 2048;

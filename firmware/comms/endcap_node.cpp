@@ -559,6 +559,8 @@ bool EndcapNode::loop_stalled(std::int64_t now) {
     loop_progress_seen_ = progress;
     loop_progress_ns_ = now;
   }
+  // Armed by the loop's first pass: the program starts its node before its loop.
+  if (progress == 0) return false;
   const bool stalled = now - loop_progress_ns_ > to_ns(config_.loop_stall_timeout_s);
   if (stalled != loop_stall_reported_ && config_.log) {
     std::fprintf(stderr, "endcap %d: control loop %s\n", config_.endcap_id,

@@ -108,7 +108,8 @@ struct SilenceWatch {
 
 // Hung loop and dead end cap: the end cap falls silent on its bus; each of its
 // drives finds out through its consumer heartbeat (0x1016) and quick-stops (0x6007).
-void expect_drives_stop_by_themselves(const HilResult& r, const SilenceWatch& snap, int endcap, const char* what) {
+void expect_drives_stop_by_themselves(const HilResult& r, const SilenceWatch& snap, int endcap, const char* what,
+                                      std::int64_t consumer_ns = kConsumerNs) {
   ASSERT_TRUE(r.ok) << r.error;
   const EndcapSummary& e = r.endcaps.at(endcap);
   ASSERT_EQ(e.devices.drive_states.size(), 2u);
@@ -120,13 +121,13 @@ void expect_drives_stop_by_themselves(const HilResult& r, const SilenceWatch& sn
     const std::int64_t detection_ns = d.lost_ns - d.last_heard_ns;
     const std::int64_t safe_ns = d.left_enabled_ns - d.lost_ns;
     const std::int64_t since_fault_ns = (d.lost_step - snap.fault_step) * kPeriodNs;
-    EXPECT_GT(detection_ns, kConsumerNs);
-    EXPECT_LE(detection_ns, kConsumerNs + kPeriodNs) << "detection bounded by the consumer heartbeat time";
+    EXPECT_GT(detection_ns, consumer_ns);
+    EXPECT_LE(detection_ns, consumer_ns + kPeriodNs) << "detection bounded by the consumer heartbeat time";
     EXPECT_GE(safe_ns, 0);
     EXPECT_LE(safe_ns, 2 * kPeriodNs) << "safe state within 2 control periods of detection";
     std::printf("MEASURE %s end cap %d drive %d: last end-cap heartbeat -> detection %.1f ms (consumer %.0f ms, "
                 "producer %.0f ms); detection -> quick stop %.1f ms; fault injected -> detection %.1f ms\n",
-                what, endcap, m, ms(detection_ns), ms(kConsumerNs), ms(kProducerNs), ms(safe_ns), ms(since_fault_ns));
+                what, endcap, m, ms(detection_ns), ms(consumer_ns), ms(kProducerNs), ms(safe_ns), ms(since_fault_ns));
   }
   for (const auto& other : r.endcaps) {
     if (other.endcap != endcap) {
@@ -167,6 +168,21 @@ TEST(HilSupervision, DeadEndCapIsStoppedByItsDrives) {
   o.after_step = [&](const WorldStepper& s, ProcessLauncher&) { snap.observe(s); };
   const HilResult r = run_hil(o);
   expect_drives_stop_by_themselves(r, snap, 9, "stop_endcap");
+}
+
+// Real time: the end caps run their own clocks and send SYNC; the stopped one just
+// stops. No other end cap may trip on its own supervision meanwhile.
+TEST(HilSupervision, DeadEndCapIsStoppedByItsDrivesInRealTime) {
+  TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
+  HilOptions o = options(2.0);
+  o.mode = StepperMode::realtime;
+  o.scenario.events.push_back(event(1.0, 9, FaultKind::stop_endcap));
+  SilenceWatch snap;
+  snap.endcap = 9;
+  o.after_step = [&](const WorldStepper& s, ProcessLauncher&) { snap.observe(s); };
+  const HilResult r = run_hil(o);
+  expect_drives_stop_by_themselves(r, snap, 9, "stop_endcap (real time)",
+                                   static_cast<std::int64_t>(kRealtimeConsumerHeartbeatS * 1e9));
 }
 
 }  // namespace
