@@ -28,8 +28,7 @@ bool quick_stops(FaultCause c) {
     case FaultCause::drive_lost:
     case FaultCause::emergency_stop:
     case FaultCause::node_rebooted:
-    case FaultCause::drive_disabled:
-    case FaultCause::stale_position: return true;
+    case FaultCause::drive_disabled: return true;
     default: return false;
   }
 }
@@ -126,10 +125,11 @@ void ControlLoop::latch(FaultCause cause, std::int64_t time_ns) {
   if (!first) return;
   pending_start_ = false;
   hold_at_measured();
-  // A drive that faulted, vanished, rebooted, fell out of operation enabled or
-  // went stale, or an operator's stop: the drives go to quick stop (decelerate,
-  // then hold with power on). Sensor faults and over-tension keep the drives
-  // enabled, holding the measured position.
+  // A drive that faulted, vanished, rebooted or fell out of operation enabled, or
+  // an operator's stop: the drives go to quick stop (decelerate, then hold with
+  // power on). Sensor faults (a stale position included: the drive is alive, its
+  // heartbeat watched) and over-tension keep the drives enabled, holding the
+  // last measured position.
   if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
   emit(AppEventKind::fault_latched, time_ns, cause);
 }

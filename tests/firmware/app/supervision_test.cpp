@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The end cap's supervision of its nodes, each detector on its own: an unexpected
 // boot-up, a drive leaving operation enabled, a stale drive position. Each is a
-// latched fault, reported in telemetry, with the drives quick-stopped in the cycle
-// that detected it.
+// latched fault, reported in telemetry, with the motors held from the cycle that
+// detected it (quick stop, or for a stale position the last measured one).
 #include <gtest/gtest.h>
 
 #include "app_bench.hpp"
@@ -16,10 +16,14 @@ using canopen::PowerRequest;
 using core::FaultCause;
 
 // The safe state the loop must be in once `cause` is latched.
+// A stale position holds the last measured one with the drives enabled, as the
+// other sensor faults do; the rest quick-stop every drive.
 void expect_safe_state(const AppBench& b, FaultCause cause) {
   EXPECT_EQ(b.loop->controller().fault(), cause);
   EXPECT_EQ(b.loop->controller().mode(), core::Mode::faulted);
-  EXPECT_EQ(b.loop->master().power_request(), PowerRequest::quick_stop);
+  const PowerRequest expected =
+      cause == FaultCause::stale_position ? PowerRequest::operation_enabled : PowerRequest::quick_stop;
+  EXPECT_EQ(b.loop->master().power_request(), expected);
   EXPECT_EQ(b.host.last.fault, cause) << "reported in telemetry";
   EXPECT_EQ(b.host.last.mode, core::Mode::faulted);
 }
