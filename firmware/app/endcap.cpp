@@ -111,6 +111,7 @@ void Endcap::start_host_link() {
       node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
     }
     node_config.link_cut = options_.link_cut;
+    node_config.loop_progress = &loop_progress_;
     auto node = std::make_unique<comms::EndcapNode>(node_config, clock_, store_.get());
     node->start();
     node_ = std::move(node);
@@ -133,6 +134,11 @@ void Endcap::activate() {
   loop_stop_.store(false);
   loop_thread_ = std::thread([this] {
     while (!loop_stop_.load(std::memory_order_relaxed)) {
+      if (options_.hang_loop != nullptr && options_.hang_loop->load(std::memory_order_relaxed)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the test hook: hung, until asked to exit
+        continue;
+      }
+      loop_progress_.fetch_add(1, std::memory_order_relaxed);
       if (config_.mode == LoopMode::realtime) {
         loop_->run_realtime_cycle();
       } else {

@@ -41,6 +41,7 @@ struct EndcapOptions {
   std::string host_loss = "continue";
   int domain = -1;  // -1: TENSEGRITY_DOMAIN or the default
   const std::atomic<bool>* link_cut = nullptr;  // --dds-cut-signals
+  const std::atomic<bool>* hang_loop = nullptr;  // --hang-loop-signal (HIL tests only)
 };
 
 // The identity `endcap --policy FILE` stores with the file's table: named after
@@ -84,6 +85,8 @@ class Endcap {
   std::unique_ptr<HostLink> node_;  // the DDS node, when there is one
   std::unique_ptr<ControlLoop> loop_;
   std::atomic<bool> loop_stop_{false};
+  // The loop's progress, one per pass (a lockstep wait included): the DDS node's watchdog.
+  std::atomic<std::uint64_t> loop_progress_{0};
   std::thread loop_thread_;
 };
 

@@ -30,6 +30,11 @@ extern "C" void on_signal(int) { g_stop.store(true); }
 std::atomic<bool> g_link_cut{false};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
 
+// HIL fault injection, tests only (--hang-loop-signal): SIGRTMIN hangs the control
+// loop for good (no cycle, no CAN heartbeat); the process and its DDS node live on.
+std::atomic<bool> g_hang_loop{false};
+extern "C" void on_hang_signal(int) { g_hang_loop.store(true); }
+
 long vm_rss_kb() {
   std::ifstream status("/proc/self/status");
   std::string line;
@@ -99,6 +104,7 @@ int main(int argc, char** argv) {
   app::EndcapOptions o;
   std::string config_path, policy_path, stats_path;
   bool cut_signals = false;
+  bool hang_signal = false;
   cli.add_option("--id", o.id, "end cap id, 0..11")->required();
   cli.add_option("--config", config_path, "configuration file (tensegrity-endcap/1 JSON)")->required();
   cli.add_option("--policy", policy_path,
@@ -116,12 +122,18 @@ int main(int argc, char** argv) {
   cli.add_option("--domain", o.domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
   cli.add_flag("--dds-cut-signals", cut_signals,
                "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
+  cli.add_flag("--hang-loop-signal", hang_signal,
+               "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
   CLI11_PARSE(cli, argc, argv);
   // First thing: a SIGUSR1 that arrived before the handler would end the program.
   if (cut_signals) {
     std::signal(SIGUSR1, on_link_signal);
     std::signal(SIGUSR2, on_link_signal);
     o.link_cut = &g_link_cut;
+  }
+  if (hang_signal) {
+    std::signal(SIGRTMIN, on_hang_signal);
+    o.hang_loop = &g_hang_loop;
   }
   o.config_path = config_path;
   o.policy_path = policy_path;

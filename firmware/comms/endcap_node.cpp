@@ -84,6 +84,7 @@ void EndcapNode::start() {
   next_telemetry_ns_ = now;
   next_heartbeat_ns_ = now;
   next_sync_ns_ = now;
+  loop_progress_ns_ = now;
   running_.store(true);
   // The remaining readers wake the node thread; created after dds_ is set.
   dds_->policy = dds_->reader(msgs::kPolicyTableTopic, dds::TypeSupport(new m::PolicyTable_PubSubType()),

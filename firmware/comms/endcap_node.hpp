@@ -113,7 +113,7 @@ class EndcapNode final : public app::HostLink {
   // node_status.cpp
   void handle_host_heartbeats(std::int64_t now_ns);
   void check_host_loss(std::int64_t now_ns);
-  bool loop_alive(std::int64_t now_ns) const;
+  bool loop_alive(std::int64_t now_ns);  // the loop-progress watchdog; logs changes
   void send_telemetry();
   void send_heartbeat(std::int64_t now_ns);
   void report_link_cut();
@@ -153,6 +153,9 @@ class EndcapNode final : public app::HostLink {
   std::int64_t next_sync_ns_ = 0;
   std::uint64_t refused_format_ = 0;
   bool link_was_cut_ = false;
+  std::uint64_t loop_progress_seen_ = 0;
+  std::int64_t loop_progress_ns_ = 0;  // node clock when the counter last moved
+  bool loop_stall_reported_ = false;
 
   // Command listener state: guarded by Dds::callback_mutex (Fast DDS may call
   // from more than one receive thread).

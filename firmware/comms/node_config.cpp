@@ -33,6 +33,7 @@ void validate(const EndcapNodeConfig& c) {
   positive(c.host_timeout_s, "host_timeout_s", 3600.0);
   positive(c.loop_ack_timeout_s, "loop_ack_timeout_s", 60.0);
   positive(c.command_max_age_s, "command_max_age_s", 3600.0);
+  positive(c.loop_stall_timeout_s, "loop_stall_timeout_s", 60.0);
   if (c.start_grid_ns < 0) {
     throw std::invalid_argument("start_grid_ns = " + std::to_string(c.start_grid_ns) + ": expected >= 0");
   }

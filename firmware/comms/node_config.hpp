@@ -41,6 +41,12 @@ struct EndcapNodeConfig {
   // Fault injection (HIL): while *link_cut is true the participant's transport
   // drops every datagram in and out (msgs/link_cut_transport.hpp). Null: never cut.
   const std::atomic<bool>* link_cut = nullptr;
+  // Watchdog: the control loop's progress counter (bumped by the loop thread every
+  // pass, a lockstep wait for SYNC included). When it stands still for
+  // loop_stall_timeout_s the node withholds its heartbeat, so the host sees a hung
+  // loop as a silent end cap. Null: no watchdog.
+  const std::atomic<std::uint64_t>* loop_progress = nullptr;
+  double loop_stall_timeout_s = 0.5;
 };
 
 // Checks rates and timeouts; throws std::invalid_argument naming the field.

@@ -49,10 +49,24 @@ void EndcapNode::check_host_loss(std::int64_t now) {
   if (lost && config_.host_loss == HostLossAction::stop) host_loss_stops_.fetch_add(1, std::memory_order_acq_rel);
 }
 
-// The one place that decides whether the control loop is alive, for the heartbeat.
-// Today: the node sends its heartbeat whatever the loop does; a loop-progress
-// watchdog (CANopen supervision) belongs here.
-bool EndcapNode::loop_alive(std::int64_t) const { return true; }
+// The one place that decides whether the control loop is alive, for the heartbeat:
+// the loop-progress watchdog. A hung loop must look dead to the host.
+bool EndcapNode::loop_alive(std::int64_t now) {
+  if (config_.loop_progress == nullptr) return true;
+  const std::uint64_t progress = config_.loop_progress->load(std::memory_order_relaxed);
+  if (progress != loop_progress_seen_) {
+    loop_progress_seen_ = progress;
+    loop_progress_ns_ = now;
+  }
+  // Armed by the loop's first pass: the program starts its node before its loop.
+  if (progress == 0) return true;
+  const bool stalled = now - loop_progress_ns_ > std::llround(config_.loop_stall_timeout_s * 1e9);
+  if (stalled != loop_stall_reported_) {
+    log("control loop %s", stalled ? "STALLED: DDS heartbeat withheld" : "progressing again: DDS heartbeat resumed");
+  }
+  loop_stall_reported_ = stalled;
+  return !stalled;
+}
 
 void EndcapNode::send_telemetry() {
   if (!loop_seen_) return;
