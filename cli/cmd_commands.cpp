@@ -3,6 +3,7 @@
 // addressed end cap, a table of who acknowledged, non-zero unless all did.
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/ground_cli.hpp"
@@ -17,13 +18,25 @@ void add_command(CLI::App& app, const std::string& name, const std::string& help
   add_ground_options(*cmd, *args, 5.0);
   cmd->callback([args, name, kind] {
     auto station = make_station(*args);
-    wait_for_endcaps(*station, *args, false);  // a missing end cap shows as MISSING below
     ground::CommandOptions options;
     options.endcap_mask = parse_endcap_set(args->endcaps);
     options.timeout_s = args->timeout_s;
+    if (kind == ground::CommandKind::emergency_stop) {
+      // No wait for discovery: the estop is written at once and re-sent every
+      // kEstopRetryIntervalS to whoever has not acked, until the deadline.
+      options.retry_interval_s = ground::kEstopRetryIntervalS;
+    } else {
+      wait_for_endcaps(*station, *args, false);  // a missing end cap shows as MISSING below
+    }
     const ground::CommandReport report = ground::send_command(*station, kind, 0, options);
     std::printf("%s", ground::format_command_report(report).c_str());
-    if (!report.all_accepted()) throw CommandError(1, name + ": not every end cap acknowledged");
+    const std::vector<int> missing = report.missing();
+    if (!missing.empty()) {
+      std::string list;
+      for (const int e : missing) list += (list.empty() ? "" : ",") + std::to_string(e);
+      throw CommandError(1, name + ": no acknowledgement from end cap(s) " + list + " before the deadline");
+    }
+    if (!report.all_accepted()) throw CommandError(1, name + ": not every end cap accepted");
   });
 }
 
@@ -34,7 +47,9 @@ void add_stop_command(CLI::App& app) {
 }
 
 void add_estop_command(CLI::App& app) {
-  add_command(app, "estop", "Emergency stop: every end cap latches a fault and holds until cleared",
+  add_command(app, "estop",
+              "Emergency stop: every end cap latches a fault and holds until cleared; re-sent every 50 ms until all "
+              "addressed end caps acked or --timeout passed (exit 1 naming the silent ones)",
               ground::CommandKind::emergency_stop);
 }
 

@@ -24,6 +24,14 @@ bool CommandReport::all_accepted() const {
   return !results.empty() && std::all_of(results.begin(), results.end(), [](const auto& r) { return r.accepted; });
 }
 
+std::vector<int> CommandReport::missing() const {
+  std::vector<int> out;
+  for (const auto& r : results) {
+    if (!r.acked) out.push_back(r.endcap);
+  }
+  return out;
+}
+
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
                            const CommandOptions& options) {
   if (options.endcap_mask == 0 || (options.endcap_mask & ~kAllEndcaps) != 0) {
@@ -89,6 +97,12 @@ std::string format_command_report(const CommandReport& report) {
     std::snprintf(line, sizeof line, "%6d  %-8s  %10.1f  %s\n", r.endcap, result, r.acked ? r.latency_s * 1e3 : 0.0,
                   r.text.c_str());
     out += line;
+  }
+  const std::vector<int> missing = report.missing();
+  if (!missing.empty()) {
+    out += "no acknowledgement from end cap(s):";
+    for (const int e : missing) out += " " + std::to_string(e);
+    out += "\n";
   }
   return out;
 }

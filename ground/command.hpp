@@ -17,9 +17,12 @@ const char* to_string(CommandKind kind);
 
 struct CommandOptions {
   std::uint16_t endcap_mask = kAllEndcaps;
-  double timeout_s = 5.0;
-  double retry_interval_s = 0.5;
+  double timeout_s = 5.0;        // the deadline: end caps silent until then are reported missing
+  double retry_interval_s = 0.5;  // re-sent (same seq) to every end cap that has not acked
 };
+// An emergency stop is re-sent more often: each retry is one more chance through a
+// lossy link, and an end cap answers a repeat without acting twice.
+inline constexpr double kEstopRetryIntervalS = 0.05;
 
 struct EndcapCommandResult {
   int endcap = 0;
@@ -35,6 +38,7 @@ struct CommandReport {
   std::int64_t start_host_time_ns = 0;
   std::vector<EndcapCommandResult> results;
   bool all_accepted() const;
+  std::vector<int> missing() const;  // addressed end caps that never acknowledged
 };
 
 // `start_host_time_ns` (host clock, Station::now_ns) is used by start only.

@@ -301,6 +301,7 @@ void StationListeners::time_sync(Station& s, dds::DataReader* r) {
     reply.format_version(msgs::kFormatVersion);
     reply.endcap_id(req.endcap_id());
     reply.seq(req.seq());
+    reply.nonce(req.nonce());
     reply.t1_ns(req.t1_ns());
     reply.t2_ns(t2);
     std::lock_guard write_lock(s.dds_->write_mutex);

@@ -28,7 +28,8 @@ class DdsError : public std::runtime_error {
 
 // Every message's first field. A peer with another value is refused (and logged),
 // never decoded as if it were ours. Bump on any change to an IDL file.
-inline constexpr std::uint16_t kFormatVersion = 1;
+// 2: time-sync request and reply carry a nonce.
+inline constexpr std::uint16_t kFormatVersion = 2;
 
 inline constexpr int kDefaultDomain = 42;
 // TENSEGRITY_DOMAIN if set (0..232, the range whose RTPS ports fit in 16 bits),
@@ -40,6 +41,9 @@ int parse_domain_id(std::string_view text);
 inline constexpr const char* kProfileDurable = "durable_events";
 inline constexpr const char* kProfileStream = "stream";
 inline constexpr const char* kProfileTimeSync = "time_sync";
+// The end cap's command reader: durable_events but VOLATILE, so a fresh end cap is
+// never handed commands a writer kept from before it matched (docs/dds.md).
+inline constexpr const char* kProfileFreshCommands = "fresh_commands";
 inline constexpr const char* kParticipantProfile = "tensegrity_participant";
 
 struct TopicSpec {

@@ -21,24 +21,18 @@ constexpr double kNsToS = 1e-9;
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
 bool is_sync(const CanFrame& f) { return !f.extended && !f.rtr && f.id == canopen::kSyncCobId && f.dlc <= 1; }
-}  // namespace
 
-const char* to_string(AppEventKind kind) {
-  switch (kind) {
-    case AppEventKind::bring_up_done: return "bring-up done";
-    case AppEventKind::bring_up_failed: return "bring-up failed";
-    case AppEventKind::fault_latched: return "fault latched";
-    case AppEventKind::fault_cleared: return "fault cleared";
-    case AppEventKind::table_accepted: return "table accepted";
-    case AppEventKind::table_rejected: return "table rejected";
-    case AppEventKind::table_swapped: return "table swapped in";
-    case AppEventKind::started: return "started";
-    case AppEventKind::start_refused: return "start refused";
-    case AppEventKind::stopped: return "stopped";
-    case AppEventKind::master_event: return "CANopen";
+bool quick_stops(FaultCause c) {
+  switch (c) {
+    case FaultCause::drive_fault:
+    case FaultCause::drive_lost:
+    case FaultCause::emergency_stop:
+    case FaultCause::node_rebooted:
+    case FaultCause::drive_disabled: return true;
+    default: return false;
   }
-  return "unknown";
 }
+}  // namespace
 
 LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   LoopSettings s;
@@ -53,6 +47,11 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   s.master.drive_heartbeat_timeout_ns = to_ns(c.drive_heartbeat_timeout_s);
   s.master.load_cell_heartbeat_timeout_ns = to_ns(c.load_cell_heartbeat_timeout_s);
   s.master.spool = c.spool();
+  s.master.master_node_id = c.endcap_node_id;
+  s.master.producer_heartbeat_period_ns = to_ns(c.endcap_heartbeat_s);
+  s.master.drive_consumer_heartbeat_ms = static_cast<std::uint16_t>(std::llround(c.drive_consumer_heartbeat_s * 1e3));
+  s.master.drive_abort_connection = c.drive_abort_connection;
+  s.safety.drive_position_timeout_ns = to_ns(c.drive_position_timeout_s);
   s.safety.motor_count = c.motor_count;
   s.safety.use_load_cell = c.use_load_cell;
   s.safety.load_cell_sample_timeout_ns = to_ns(c.load_cell_sample_timeout_s);
@@ -109,12 +108,12 @@ void ControlLoop::latch(FaultCause cause, std::int64_t time_ns) {
   if (!first) return;
   pending_start_ = false;
   hold_at_measured();
-  // A drive that faulted or vanished, or an operator's stop: the drives go to
-  // quick stop (decelerate, then hold with power on). Sensor faults and
-  // over-tension keep the drives enabled, holding the measured position.
-  if (cause == FaultCause::drive_fault || cause == FaultCause::drive_lost || cause == FaultCause::emergency_stop) {
-    master_.request_power(PowerRequest::quick_stop);
-  }
+  // A drive that faulted, vanished, rebooted or fell out of operation enabled, or
+  // an operator's stop: the drives go to quick stop (decelerate, then hold with
+  // power on). Sensor faults (a stale position included: the drive is alive, its
+  // heartbeat watched) and over-tension keep the drives enabled, holding the
+  // last measured position.
+  if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
   emit(AppEventKind::fault_latched, time_ns, cause);
 }
 
@@ -163,45 +162,69 @@ void ControlLoop::handle_bring_up(std::int64_t time_ns) {
   }
 }
 
+// Counters the host link raises (emergency_stops, host_loss_stops): a change since
+// the last look is a stop to apply now.
+void ControlLoop::apply_host_stops(std::uint32_t estops, std::uint32_t host_loss_stops, std::int64_t time_ns) {
+  if (estops != estops_seen_) {
+    estops_seen_ = estops;
+    latch(FaultCause::emergency_stop, time_ns);
+  }
+  if (host_loss_stops != host_loss_stops_seen_) {
+    host_loss_stops_seen_ = host_loss_stops;
+    HostCommand stop;
+    stop.kind = CommandKind::stop;
+    apply_command(stop, time_ns);
+  }
+}
+
+void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns) {
+  switch (command.kind) {
+    case CommandKind::start:
+      if (command.start_time_ns > time_ns && drives_enabled() && controller_.has_table() &&
+          controller_.fault() == FaultCause::none) {
+        pending_start_ = true;
+        pending_start_ns_ = command.start_time_ns;
+      } else {
+        try_start(command.start_time_ns, time_ns);
+      }
+      break;
+    case CommandKind::stop:
+      pending_start_ = false;
+      if (controller_.mode() == core::Mode::running) emit(AppEventKind::stopped, time_ns);
+      controller_.stop();
+      break;
+    case CommandKind::emergency_stop: latch(FaultCause::emergency_stop, time_ns); break;
+    case CommandKind::clear_fault: {
+      if (controller_.fault() == FaultCause::none) break;
+      const FaultCause was = controller_.fault();
+      controller_.clear_fault();
+      hold_at_measured();
+      master_.request_fault_reset();
+      master_.request_power(PowerRequest::operation_enabled);
+      grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
+      // A node that rebooted while lost is pre-operational again: bring it up anew.
+      bool all_operational = master_.heartbeat(NodeRole::load_cell).state == NmtState::operational ||
+                             !settings_.master.use_load_cell;
+      for (std::size_t i = 0; i < master_.drive_count(); ++i) {
+        all_operational = all_operational && master_.drive_heartbeat(i).state == NmtState::operational;
+      }
+      if (!all_operational) bring_up_started_ = false;
+      emit(AppEventKind::fault_cleared, time_ns, was);
+      break;
+    }
+  }
+}
+
 void ControlLoop::handle_host(std::int64_t time_ns) {
   HostCommand command;
   while (host_.try_take_command(command)) {
-    switch (command.kind) {
-      case CommandKind::start:
-        if (command.start_time_ns > time_ns && drives_enabled() && controller_.has_table() &&
-            controller_.fault() == FaultCause::none) {
-          pending_start_ = true;
-          pending_start_ns_ = command.start_time_ns;
-        } else {
-          try_start(command.start_time_ns, time_ns);
-        }
-        break;
-      case CommandKind::stop:
-        pending_start_ = false;
-        if (controller_.mode() == core::Mode::running) emit(AppEventKind::stopped, time_ns);
-        controller_.stop();
-        break;
-      case CommandKind::emergency_stop: latch(FaultCause::emergency_stop, time_ns); break;
-      case CommandKind::clear_fault: {
-        if (controller_.fault() == FaultCause::none) break;
-        const FaultCause was = controller_.fault();
-        controller_.clear_fault();
-        hold_at_measured();
-        master_.request_fault_reset();
-        master_.request_power(PowerRequest::operation_enabled);
-        grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
-        // A node that rebooted while lost is pre-operational again: bring it up anew.
-        bool all_operational = master_.heartbeat(NodeRole::load_cell).state == NmtState::operational ||
-                               !settings_.master.use_load_cell;
-        for (std::size_t i = 0; i < master_.drive_count(); ++i) {
-          all_operational = all_operational && master_.drive_heartbeat(i).state == NmtState::operational;
-        }
-        if (!all_operational) bring_up_started_ = false;
-        emit(AppEventKind::fault_cleared, time_ns, was);
-        break;
-      }
+    // An estop sent before this command lands first (HostCommand::estops_before).
+    if (static_cast<std::int32_t>(command.estops_before - estops_seen_) > 0) {
+      apply_host_stops(command.estops_before, host_loss_stops_seen_, time_ns);
     }
+    apply_command(command, time_ns);
   }
+  apply_host_stops(host_.emergency_stops(), host_.host_loss_stops(), time_ns);
   if (pending_start_ && time_ns >= pending_start_ns_) {
     pending_start_ = false;
     try_start(pending_start_ns_, time_ns);
@@ -216,14 +239,16 @@ void ControlLoop::handle_host(std::int64_t time_ns) {
     e.time_ns = time_ns;
     e.table_error = error;
     events_.push(e);
-    // Persisting means fsync: the housekeeping thread does it, never this one.
-    if (error == core::TableError::none) persist_.write(incoming.table);
   }
 }
 
 void ControlLoop::drain_bus(std::int64_t time_ns) {
   CanFrame frame;
-  while (bus_.receive(frame, 0) == CanResult::ok) master_.on_frame(frame, time_ns);
+  for (int n = 0; n < kMaxFramesPerCycle; ++n) {
+    if (bus_.receive(frame, 0) != CanResult::ok) return;
+    master_.on_frame(frame, time_ns);
+  }
+  ++status_.drain_limited_cycles;  // frames may remain: the next cycle takes them
 }
 
 void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
@@ -245,7 +270,9 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
 
   const bool armed = master_.bring_up_step() == BringUpStep::done;
   FaultCause cause = safety_.check(master_, time_ns, armed);
-  if (cause == FaultCause::drive_fault && time_ns < grace_until_ns_) cause = FaultCause::none;
+  // The fault-reset handshake passes through states other than operation enabled.
+  const bool resetting = cause == FaultCause::drive_fault || cause == FaultCause::drive_disabled;
+  if (resetting && time_ns < grace_until_ns_) cause = FaultCause::none;
   latch(cause, time_ns);
 
   // The newest valid reading per motor; a channel that stays invalid trips

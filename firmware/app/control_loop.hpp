@@ -85,6 +85,8 @@ struct LoopStatus {
   core::FaultCause fault = core::FaultCause::none;
   canopen::BringUpStep bring_up = canopen::BringUpStep::idle;
   std::uint64_t events_lost = 0;
+  // Cycles whose bus drain stopped at kMaxFramesPerCycle with frames still queued.
+  std::uint64_t drain_limited_cycles = 0;
 };
 
 class ControlLoop {
@@ -102,7 +104,10 @@ class ControlLoop {
   bool run_lockstep_cycle(std::int64_t wait_timeout_ns);
 
   // Building blocks, public for tests: the control cycle at loop time `time_ns`,
-  // and draining every frame already queued on the bus into the master.
+  // and draining the frames already queued on the bus into the master, at most
+  // kMaxFramesPerCycle of them: a flooded bus must not starve the cycle. What is
+  // left waits for the next cycle (counted in LoopStatus::drain_limited_cycles).
+  static constexpr int kMaxFramesPerCycle = 256;
   void cycle(std::int64_t time_ns, double dt_s);
   void drain_bus(std::int64_t time_ns);
 
@@ -116,9 +121,9 @@ class ControlLoop {
   // Realtime: the clock reading at loop time 0 (0 before the first cycle, and in lockstep).
   std::int64_t clock_origin_ns() const { return origin_ns_; }
 
-  // For the other thread (housekeeping): events to log, tables to persist, status.
+  // For the other thread (housekeeping): events to log, status. Tables are
+  // persisted before they reach the loop (the DDS node, with their identity).
   bool pop_event(AppEvent& event) { return events_.pop(event); }
-  bool take_table_to_persist(core::EndcapTable& table) { return persist_.read(table); }
   bool read_status(LoopStatus& status) { return status_out_.read(status); }
 
  private:
@@ -127,6 +132,8 @@ class ControlLoop {
   void hold_at_measured();
   void handle_bring_up(std::int64_t time_ns);
   void handle_host(std::int64_t time_ns);
+  void apply_command(const HostCommand& command, std::int64_t time_ns);
+  void apply_host_stops(std::uint32_t estops, std::uint32_t host_loss_stops, std::int64_t time_ns);
   void try_start(std::int64_t start_time_ns, std::int64_t time_ns);
   void publish(std::int64_t time_ns, const core::StepStatus& step);
   void update_status();
@@ -150,6 +157,8 @@ class ControlLoop {
   std::int64_t grace_until_ns_ = 0;
   std::uint32_t table_ack_sequence_ = 0;
   core::TableError table_ack_error_ = core::TableError::none;
+  std::uint32_t estops_seen_ = 0;
+  std::uint32_t host_loss_stops_seen_ = 0;
 
   // Realtime pacing.
   bool timer_started_ = false;
@@ -167,7 +176,6 @@ class ControlLoop {
   Telemetry telemetry_;
 
   SpscRing<AppEvent, 256> events_;
-  LatestValue<core::EndcapTable> persist_;
   LatestValue<LoopStatus> status_out_;
 };
 

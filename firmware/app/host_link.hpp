@@ -30,6 +30,10 @@ struct HostCommand {
   // with the table already that far along (keeps end caps in step). The comms
   // layer maps host time to loop time.
   std::int64_t start_time_ns = 0;
+  // HostLink::emergency_stops() when the command was queued: an estop the host
+  // sent before this command is applied before it, even when both reach the loop
+  // in one cycle (an estop then a clear-fault must end cleared, not stopped).
+  std::uint32_t estops_before = 0;
 };
 
 struct Telemetry {
@@ -57,6 +61,12 @@ class HostLink {
   virtual bool try_take_command(HostCommand& out) noexcept = 0;
   // Called every cycle; an implementation keeps the newest and sends at its own rate.
   virtual void publish(const Telemetry& telemetry) noexcept = 0;
+  // Read every cycle: how many emergency stops the host has sent, and how many
+  // host-loss stops the link has ordered. Counters, not mailbox entries: one can
+  // never be refused for a full queue or lost, and the loop latches the safe state
+  // in the cycle after it changes.
+  virtual std::uint32_t emergency_stops() const noexcept { return 0; }
+  virtual std::uint32_t host_loss_stops() const noexcept { return 0; }
 };
 
 // No host yet: tables come from --policy and the store, start from --start-on-boot.

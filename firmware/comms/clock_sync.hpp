@@ -23,7 +23,8 @@ class ClockSyncEstimator {
   static constexpr std::size_t kWindow = 16;
 
   // Returns false for an impossible sample (negative round trip: a host that
-  // answered before it was asked, or clocks read out of order).
+  // answered before it was asked, or clocks read out of order) or a stamp outside
+  // +-2^62 ns (wire_time.hpp), checked before any arithmetic.
   bool add(std::int64_t t1_ns, std::int64_t t2_ns, std::int64_t t3_ns, std::int64_t t4_ns);
   bool synced() const { return count_ > 0; }
   // The smallest-round-trip sample of the window; zeros before the first sample.
@@ -31,6 +32,7 @@ class ClockSyncEstimator {
   std::int64_t to_host_ns(std::int64_t local_ns) const { return local_ns + best().offset_ns; }
   std::int64_t to_local_ns(std::int64_t host_ns) const { return host_ns - best().offset_ns; }
   std::size_t samples() const { return count_; }
+  void reset() { count_ = 0; next_ = 0; }
 
  private:
   std::array<ClockSample, kWindow> window_{};

@@ -38,7 +38,9 @@ std::string format(const char* fmt, auto... args) {
 
 }  // namespace
 
-std::uint32_t policy_checksum(const PolicyTableMsg& msg) {
+namespace {
+// The checksummed encoding (docs/dds.md "Policy checksum").
+LeWriter encode(const PolicyTableMsg& msg) {
   LeWriter w;
   w.u32(0x31435054U);  // "TPC1"
   w.u32(static_cast<std::uint32_t>(static_cast<std::int32_t>(msg.endcap_id())));
@@ -51,7 +53,20 @@ std::uint32_t policy_checksum(const PolicyTableMsg& msg) {
   for (const double v : msg.rest_length_m()) w.f64(v);
   w.text(msg.policy_id().to_string());
   w.text(msg.robot().to_string());
-  return crc32(w.bytes());
+  return w;
+}
+}  // namespace
+
+std::uint32_t policy_checksum(const PolicyTableMsg& msg) { return crc32(encode(msg).bytes()); }
+
+std::uint64_t policy_digest(const PolicyTableMsg& msg) {
+  LeWriter w = encode(msg);
+  w.u32(msg.checksum());
+  w.u32(msg.force() ? 1U : 0U);
+  w.u32(static_cast<std::uint32_t>(static_cast<std::int32_t>(msg.target_endcap())));
+  std::uint64_t h = 0xCBF29CE484222325ULL;  // FNV-1a 64
+  for (const std::uint8_t b : w.bytes()) h = (h ^ b) * 0x100000001B3ULL;
+  return h;
 }
 
 PolicyTableMsg make_policy_message(const core::EndcapTable& table, int endcap, const PolicyIdentity& identity,

@@ -24,6 +24,11 @@ namespace tensegrity::fw::comms {
 using PolicyTableMsg = tensegrity_msgs::msg::dds_::PolicyTable_;
 
 std::uint32_t policy_checksum(const PolicyTableMsg& msg);
+// A 64-bit digest (FNV-1a) of everything a table message says: the checksummed
+// fields, the checksum field itself, force and the addressing. A retry is the same
+// upload_sequence AND the same digest; a different table under a reused sequence
+// is judged anew.
+std::uint64_t policy_digest(const PolicyTableMsg& msg);
 
 struct PolicyIdentity {
   std::string policy_id;

@@ -21,6 +21,7 @@ const char* describe(PolicyReason reason) noexcept {
     case PolicyReason::stale_version: return "version is not newer than the active policy (use force)";
     case PolicyReason::loop_busy: return "control loop did not take the table in time";
     case PolicyReason::bad_policy_id: return "policy id is empty";
+    case PolicyReason::storage_failed: return "could not store the table durably: nothing changed";
   }
   return "unknown reason";
 }
@@ -43,6 +44,7 @@ const char* to_string(PolicyReason reason) noexcept {
     case PolicyReason::stale_version: return "stale_version";
     case PolicyReason::loop_busy: return "loop_busy";
     case PolicyReason::bad_policy_id: return "bad_policy_id";
+    case PolicyReason::storage_failed: return "storage_failed";
   }
   return "unknown";
 }
@@ -55,6 +57,9 @@ const char* describe(CommandReason reason) noexcept {
     case CommandReason::clock_not_synced: return "no time-sync reply from the host yet: cannot place the start time";
     case CommandReason::loop_not_running: return "no telemetry from the control loop: cannot place the start time";
     case CommandReason::mailbox_full: return "command mailbox to the control loop is full";
+    case CommandReason::out_of_order: return "older than a command this writer already sent: not acted on";
+    case CommandReason::stale: return "start issued too long ago (host time): not acted on";
+    case CommandReason::bad_time: return "start time outside the valid range";
   }
   return "unknown reason";
 }

@@ -27,6 +27,7 @@ enum class PolicyReason : std::uint8_t {
   stale_version = 13,
   loop_busy = 14,     // the control loop did not take the table in time
   bad_policy_id = 15,
+  storage_failed = 16,  // the table and its identity could not be made durable: nothing changed
 };
 
 enum class CommandReason : std::uint8_t {
@@ -35,7 +36,10 @@ enum class CommandReason : std::uint8_t {
   unknown_kind = 2,
   clock_not_synced = 3,  // a start needs the host's clock: no time-sync reply yet
   loop_not_running = 4,  // no telemetry from the control loop: cannot map the start time
-  mailbox_full = 5,
+  mailbox_full = 5,      // never for an emergency stop (a latched counter, no mailbox)
+  out_of_order = 6,      // older than a command this writer already sent: not acted on
+  stale = 7,             // a start issued longer ago than command_max_age_s (host time)
+  bad_time = 8,          // a start's host time is outside the valid range
 };
 
 const char* describe(PolicyReason reason) noexcept;

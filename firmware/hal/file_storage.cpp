@@ -60,7 +60,11 @@ bool write_all(int fd, const std::uint8_t* p, std::size_t n) {
   return true;
 }
 
+thread_local int t_last_errno = 0;
+
 }  // namespace
+
+int FileStorage::last_errno() { return t_last_errno; }
 
 const char* to_string(StorageResult result) {
   switch (result) {
@@ -98,12 +102,12 @@ StorageResult FileStorage::read(std::string_view name, std::vector<std::uint8_t>
   if (!is_valid_blob_name(name)) return StorageResult::invalid_name;
   Fd fd(::open(blob_path(name).c_str(), O_RDONLY | O_CLOEXEC));
   if (fd.get() < 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     return errno == ENOENT ? StorageResult::not_found : StorageResult::io_error;
   }
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     return StorageResult::io_error;
   }
   const auto file_bytes = static_cast<std::size_t>(st.st_size);
@@ -116,7 +120,7 @@ StorageResult FileStorage::read(std::string_view name, std::vector<std::uint8_t>
     const ssize_t r = ::read(fd.get(), bytes.data() + got, file_bytes - got);
     if (r < 0 && errno == EINTR) continue;
     if (r < 0) {
-      last_errno_ = errno;
+      t_last_errno = errno;
       return StorageResult::io_error;
     }
     if (r == 0) return StorageResult::corrupt;  // shrank under us
@@ -143,29 +147,30 @@ StorageResult FileStorage::write(std::string_view name, std::span<const std::uin
   put_u32(header.data() + 8, static_cast<std::uint32_t>(data.size()));
   put_u32(header.data() + 12, crc32(data));
 
+  const std::lock_guard lock(write_mutex_);
   const std::filesystem::path tmp = temp_path(name);
   // O_TRUNC: a temp file left by an interrupted earlier write is simply reused.
   Fd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
   if (fd.get() < 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     return StorageResult::io_error;
   }
   const bool written = write_all(fd.get(), header.data(), header.size()) &&
                        write_all(fd.get(), data.data(), data.size()) && ::fsync(fd.get()) == 0;
   if (!written || fd.release_close() != 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     ::unlink(tmp.c_str());
     return StorageResult::io_error;
   }
   if (::rename(tmp.c_str(), blob_path(name).c_str()) != 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     ::unlink(tmp.c_str());
     return StorageResult::io_error;
   }
   // Without this the rename may be lost on power failure even though the data was synced.
   Fd dir(::open(directory_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
   if (dir.get() < 0 || ::fsync(dir.get()) != 0) {
-    last_errno_ = errno;
+    t_last_errno = errno;
     return StorageResult::io_error;
   }
   return StorageResult::ok;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -48,12 +49,15 @@ class FileStorage final : public Storage {
   const std::filesystem::path& directory() const { return directory_; }
   std::filesystem::path blob_path(std::string_view name) const;
   std::filesystem::path temp_path(std::string_view name) const;
-  // errno of the last io_error, for the log line.
-  int last_errno() const { return last_errno_; }
+  // errno of the calling thread's last io_error, for its log line. Per thread:
+  // the node persists while the main thread may read, and a value shared by both
+  // would be a data race and could name the other thread's error.
+  static int last_errno();
 
  private:
   std::filesystem::path directory_;
-  int last_errno_ = 0;
+  // Two writers of one blob would share its temp file: writes are serialised.
+  std::mutex write_mutex_;
 };
 
 }  // namespace tensegrity::fw

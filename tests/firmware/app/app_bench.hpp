@@ -30,7 +30,9 @@ class ScriptedHostLink final : public HostLink {
     return true;
   }
   void publish(const Telemetry& t) noexcept override { last = t; }
+  std::uint32_t emergency_stops() const noexcept override { return estops; }
 
+  std::uint32_t estops = 0;
   std::deque<HostTable> tables;
   std::deque<HostCommand> commands;
   Telemetry last;

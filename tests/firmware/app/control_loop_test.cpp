@@ -67,7 +67,11 @@ TEST(ControlLoop, DriveEmcyTripsAndQuickStopsInOneCycle) {
 }
 
 TEST(ControlLoop, MissedDriveHeartbeatTripsDriveLostInTheSameCycle) {
-  AppBench b;
+  // The drive's positions stop with it and would trip stale_position first (20 ms,
+  // supervision_test.cpp): here only the heartbeat path is under test.
+  LoopSettings s = bench_settings();
+  s.safety.drive_position_timeout_ns = 10'000'000'000;
+  AppBench b(s);
   ASSERT_TRUE(b.start_running());
   b.bus.set_connected(b.drive0, false);
   int cycles = 0;
@@ -133,6 +137,55 @@ TEST(ControlLoop, EmergencyStopCommandLatches) {
   EXPECT_EQ(b.loop->master().power_request(), canopen::PowerRequest::quick_stop);
 }
 
+TEST(ControlLoop, EmergencyStopCounterLatchesInTheNextCycleWhateverTheMailboxHolds) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  for (int i = 0; i < 64; ++i) b.host.commands.push_back({CommandKind::stop, 0});  // a flood of stops
+  b.host.estops = 1;
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
+  EXPECT_EQ(b.loop->master().power_request(), canopen::PowerRequest::quick_stop);
+}
+
+TEST(ControlLoop, AnEstopSentBeforeAClearFaultIsAppliedBeforeIt) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  // The host sent estop, then clear-fault; both reach the loop in one cycle.
+  b.host.estops = 1;
+  HostCommand clear{CommandKind::clear_fault, 0};
+  clear.estops_before = 1;
+  b.host.commands.push_back(clear);
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none) << "cleared after the estop, not before";
+  EXPECT_TRUE(b.has_event(AppEventKind::fault_cleared));
+  // A clear sent before the estop leaves it latched.
+  HostCommand early_clear{CommandKind::clear_fault, 0};
+  early_clear.estops_before = 1;
+  b.host.commands.push_back(early_clear);
+  b.host.estops = 2;
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
+}
+
+TEST(ControlLoop, DrainBusStopsAtItsPerCycleBoundOnAFloodedBus) {
+  AppBench b;
+  CanFrame junk;
+  junk.id = 0x7FF;  // no CANopen node of ours
+  junk.dlc = 0;
+  const int flood = 3 * ControlLoop::kMaxFramesPerCycle + 10;
+  for (int i = 0; i < flood; ++i) b.bus.inject_to_receiver(junk);
+  const auto queued = static_cast<int>(b.bus.pending());  // the flood and the devices' boot-ups
+  ASSERT_GE(queued, flood);
+  b.loop->drain_bus(0);
+  EXPECT_EQ(b.loop->status().drain_limited_cycles, 1U);
+  EXPECT_EQ(static_cast<int>(b.bus.pending()), queued - ControlLoop::kMaxFramesPerCycle) << "the rest waits";
+  b.loop->drain_bus(0);
+  b.loop->drain_bus(0);
+  b.loop->drain_bus(0);
+  EXPECT_EQ(b.bus.pending(), 0U);
+  EXPECT_EQ(b.loop->status().drain_limited_cycles, 3U);
+}
+
 TEST(ControlLoop, HostTableSwapsInAtAPeriodBoundary) {
   AppBench b;
   ASSERT_TRUE(b.start_running(bench_table(0.2)));
@@ -143,9 +196,6 @@ TEST(ControlLoop, HostTableSwapsInAtAPeriodBoundary) {
   EXPECT_TRUE(b.has_event(AppEventKind::table_accepted));
   EXPECT_EQ(b.host.last.table_ack_sequence, 7U);
   EXPECT_TRUE(b.loop->controller().has_pending_table()) << "not mid-period";
-  core::EndcapTable persisted;
-  EXPECT_TRUE(b.loop->take_table_to_persist(persisted));
-  EXPECT_EQ(persisted.period_s, 0.1);
   ASSERT_TRUE(b.run_until([&] { return b.has_event(AppEventKind::table_swapped); }, 300));
   const AppEvent* swap = nullptr;
   for (const AppEvent& e : b.events) {

@@ -17,8 +17,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/app/policy_store.hpp"
 #include "firmware/drivers/pdo_codec.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
+#include "firmware/hal/crc32.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
 #include "hil/devices/cia402_drive.hpp"
 #include "hil/devices/load_cell.hpp"
@@ -198,6 +200,16 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
   EXPECT_EQ(stats["cycles"].get<std::uint64_t>(), stats["syncs_received"].get<std::uint64_t>())
       << "lockstep: one cycle per SYNC";
   EXPECT_EQ(stats["fault"], "none");
+  // --policy FILE stored the table with its own identity, as one record.
+  FileStorage storage(dir / "store");
+  app::PolicyStore store(storage, 2, core::MotorLimits{});
+  app::StoredTable stored;
+  std::string report;
+  ASSERT_TRUE(store.load(stored, report)) << report;
+  EXPECT_EQ(stored.identity.policy_id, "file:policy");
+  EXPECT_EQ(stored.identity.policy_version, 0U);
+  EXPECT_EQ(stored.identity.checksum, crc32(app::encode_table(app::StoredTable{0, stored.table, {}})));
+  EXPECT_DOUBLE_EQ(stored.table.period_s, 0.4);
   fs::remove_all(dir);
 }
 

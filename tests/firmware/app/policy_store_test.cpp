@@ -144,8 +144,52 @@ TEST_F(PolicyStoreTest, InvalidTableIsNotStored) {
   EXPECT_DOUBLE_EQ(loaded_first_m(), -1.0);
 }
 
+TEST_F(PolicyStoreTest, TableAndIdentityAreOneRecord) {
+  PolicyStore s = store();
+  std::string error;
+  ASSERT_EQ(s.save(table_with(0.7), StoredIdentity{"gait", 4, 0xABCD}, error), StorageResult::ok) << error;
+  ASSERT_EQ(s.save(table_with(0.8), StoredIdentity{"gait", 5, 0x1234}, error), StorageResult::ok) << error;
+  StoredTable current;
+  ASSERT_TRUE(s.current(current));
+  EXPECT_EQ(current.identity.policy_version, 5U);
+  StoredTable loaded;
+  std::string report;
+  PolicyStore rebooted = store();
+  ASSERT_TRUE(rebooted.load(loaded, report));
+  EXPECT_DOUBLE_EQ(loaded.table.rest_length_m[0][0], 0.8);
+  EXPECT_EQ(loaded.identity.policy_id, "gait");
+  EXPECT_EQ(loaded.identity.policy_version, 5U);
+  EXPECT_EQ(loaded.identity.checksum, 0x1234U);
+  // The newest record lost: the previous table comes back with its own identity.
+  fs::resize_file(newest_file(), 20);
+  PolicyStore again = store();
+  ASSERT_TRUE(again.load(loaded, report));
+  EXPECT_DOUBLE_EQ(loaded.table.rest_length_m[0][0], 0.7);
+  EXPECT_EQ(loaded.identity.policy_version, 4U);
+  EXPECT_EQ(loaded.identity.checksum, 0xABCDU);
+}
+
+TEST_F(PolicyStoreTest, AnOverlongPolicyIdIsRefusedNotTruncated) {
+  PolicyStore s = store();
+  std::string error;
+  EXPECT_NE(s.save(table_with(0.7), StoredIdentity{std::string(65, 'x'), 1, 1}, error), StorageResult::ok);
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(PolicyStoreCodec, VersionOneRecordsDecodeWithoutAnIdentity) {
+  StoredTable s{3, table_with(0.7), {}};
+  std::vector<std::uint8_t> bytes = encode_table(s);
+  // ETB1: the same record without the identity's 12 bytes (version, checksum, id length 0).
+  bytes[3] = '1';
+  bytes.resize(bytes.size() - 12);
+  StoredTable out;
+  ASSERT_TRUE(decode_table(bytes, out));
+  EXPECT_TRUE(out.identity.policy_id.empty());
+  EXPECT_DOUBLE_EQ(out.table.rest_length_m[1][2], 0.7 + 0.02 + 0.1);
+}
+
 TEST(PolicyStoreCodec, DecodeRejectsTrailingAndShortBytes) {
-  StoredTable s{3, table_with(0.7)};
+  StoredTable s{3, table_with(0.7), {"gait", 2, 7}};
   std::vector<std::uint8_t> bytes = encode_table(s);
   StoredTable out;
   ASSERT_TRUE(decode_table(bytes, out));

@@ -6,6 +6,11 @@
 //   comms_test_node --domain D [--endcaps 0-11] [--loop-hz 500] [--telemetry-hz 100]
 //     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
+//     [--stall-commands] [--dds-cut-signals]
+// --stall-commands: the stub loops never take a command from the mailbox (it
+// fills up), but read the emergency-stop counter every cycle.
+// --dds-cut-signals: SIGUSR1 cuts every node's DDS link, SIGUSR2 restores it.
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +23,7 @@
 #include <vector>
 
 #include "firmware/comms/endcap_node.hpp"
+#include "firmware/app/policy_store.hpp"
 #include "firmware/hal/storage.hpp"
 #include "tests/firmware/comms/stub_loop.hpp"
 
@@ -25,6 +31,8 @@ namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
+std::atomic<bool> g_link_cut{false};
+extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
 
 // "0-11", "3", "0,2,5-7" -> bit mask
 unsigned parse_set(const std::string& text) {
@@ -47,6 +55,7 @@ unsigned parse_set(const std::string& text) {
 struct Endcap {
   std::unique_ptr<tensegrity::test::OffsetClock> clock;
   std::unique_ptr<tensegrity::fw::FileStorage> storage;
+  std::unique_ptr<tensegrity::fw::app::PolicyStore> store;
   std::unique_ptr<tensegrity::fw::comms::EndcapNode> node;
   std::unique_ptr<tensegrity::test::StubLoop> loop;
 };
@@ -61,6 +70,8 @@ int main(int argc, char** argv) {
   double loop_hz = 500.0;
   double spread_s = 0.0;
   std::string storage_dir;
+  bool stall_commands = false;
+  bool cut_signals = false;
   fw::comms::EndcapNodeConfig base;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -80,6 +91,8 @@ int main(int argc, char** argv) {
       else if (arg == "--storage") storage_dir = value();
       else if (arg == "--motor-count") base.expect.motor_count = static_cast<std::uint32_t>(std::stoul(value()));
       else if (arg == "--quiet") base.log = false;
+      else if (arg == "--stall-commands") stall_commands = true;
+      else if (arg == "--dds-cut-signals") cut_signals = true;
       else throw std::invalid_argument("unknown argument " + arg);
     }
     if (domain < 0) throw std::invalid_argument("--domain is required");
@@ -90,6 +103,11 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGTERM, on_signal);
   std::signal(SIGINT, on_signal);
+  if (cut_signals) {
+    std::signal(SIGUSR1, on_link_signal);
+    std::signal(SIGUSR2, on_link_signal);
+    base.link_cut = &g_link_cut;
+  }
 
   std::mt19937_64 rng(1234);  // the same offsets every run
   std::uniform_real_distribution<double> offset(-spread_s, spread_s);
@@ -103,13 +121,18 @@ int main(int argc, char** argv) {
         const auto dir = std::filesystem::path(storage_dir) / ("endcap" + std::to_string(e));
         std::filesystem::create_directories(dir);
         c.storage = std::make_unique<fw::FileStorage>(dir);
+        c.store = std::make_unique<fw::app::PolicyStore>(*c.storage, base.expect.motor_count, base.expect.limits);
+        fw::app::StoredTable restored;
+        std::string report;
+        c.store->load(restored, report);
       }
       fw::comms::EndcapNodeConfig config = base;
       config.endcap_id = e;
       config.domain = domain;
       if ((stop_set & (1U << e)) != 0) config.host_loss = fw::comms::HostLossAction::stop;
-      c.node = std::make_unique<fw::comms::EndcapNode>(config, *c.clock, c.storage.get());
-      c.loop = std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count);
+      c.node = std::make_unique<fw::comms::EndcapNode>(config, *c.clock, c.store.get());
+      c.loop = std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count,
+                                                stall_commands);
       c.node->start();
       c.loop->start();
       caps.push_back(std::move(c));

@@ -77,7 +77,7 @@ struct BadCase {
 void rechecksum(PolicyTableMsg& m) { m.checksum(policy_checksum(m)); }
 
 const BadCase kBadCases[] = {
-    {"format", [](PolicyTableMsg& m) { m.format_version(2); }, PolicyReason::wrong_format_version},
+    {"format", [](PolicyTableMsg& m) { m.format_version(msgs::kFormatVersion + 1); }, PolicyReason::wrong_format_version},
     {"endcap", [](PolicyTableMsg& m) { m.endcap_id(4); rechecksum(m); }, PolicyReason::wrong_endcap},
     {"robot", [](PolicyTableMsg& m) { m.robot("other"); rechecksum(m); }, PolicyReason::wrong_robot},
     {"empty_id", [](PolicyTableMsg& m) { m.policy_id(""); rechecksum(m); }, PolicyReason::bad_policy_id},

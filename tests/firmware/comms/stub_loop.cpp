@@ -16,12 +16,14 @@ core::EndcapConfig make_config(std::uint32_t motor_count) {
 }
 }  // namespace
 
-StubLoop::StubLoop(int endcap, fw::app::HostLink& host, OffsetClock& clock, double rate_hz, std::uint32_t motor_count)
+StubLoop::StubLoop(int endcap, fw::app::HostLink& host, OffsetClock& clock, double rate_hz, std::uint32_t motor_count,
+                   bool stall_commands)
     : endcap_(endcap),
       host_(host),
       clock_(clock),
       period_ns_(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
-      controller_(make_config(motor_count)) {
+      controller_(make_config(motor_count)),
+      stall_commands_(stall_commands) {
   for (auto& c : commanded_) c = controller_.config().initial_rest_length_m;
 }
 
@@ -52,27 +54,52 @@ void StubLoop::run() {
   }
 }
 
+void StubLoop::apply_estops(std::uint32_t estops) {
+  if (estops == estops_seen_) return;
+  estops_seen_ = estops;
+  pending_start_ = false;
+  controller_.trip(core::FaultCause::emergency_stop);
+  std::printf("ESTOPPED endcap=%d true_ns=%lld\n", endcap_, true_now_ns());
+}
+
+void StubLoop::apply(const fw::app::HostCommand& command, std::int64_t loop_ns) {
+  switch (command.kind) {
+    case fw::app::CommandKind::start:
+      if (command.start_time_ns > loop_ns) {
+        pending_start_ = true;
+        pending_start_ns_ = command.start_time_ns;
+      } else if (controller_.start(command.start_time_ns)) {
+        std::printf("STARTED endcap=%d true_ns=%lld late\n", endcap_,
+                    static_cast<long long>(command.start_time_ns + origin_local_ns_ - clock_.offset_ns()));
+      }
+      break;
+    case fw::app::CommandKind::stop:
+      pending_start_ = false;
+      controller_.stop();
+      std::printf("STOPPED endcap=%d\n", endcap_);
+      break;
+    case fw::app::CommandKind::emergency_stop: controller_.trip(core::FaultCause::emergency_stop); break;
+    case fw::app::CommandKind::clear_fault:
+      if (controller_.fault() != core::FaultCause::none) {
+        controller_.clear_fault();
+        std::printf("CLEARED endcap=%d true_ns=%lld\n", endcap_, true_now_ns());
+      }
+      break;
+  }
+}
+
 void StubLoop::cycle(std::int64_t loop_ns, double dt_s) {
   fw::app::HostCommand command;
-  while (host_.try_take_command(command)) {
-    switch (command.kind) {
-      case fw::app::CommandKind::start:
-        if (command.start_time_ns > loop_ns) {
-          pending_start_ = true;
-          pending_start_ns_ = command.start_time_ns;
-        } else if (controller_.start(command.start_time_ns)) {
-          std::printf("STARTED endcap=%d true_ns=%lld late\n", endcap_,
-                      static_cast<long long>(command.start_time_ns + origin_local_ns_ - clock_.offset_ns()));
-        }
-        break;
-      case fw::app::CommandKind::stop:
-        pending_start_ = false;
-        controller_.stop();
-        std::printf("STOPPED endcap=%d\n", endcap_);
-        break;
-      case fw::app::CommandKind::emergency_stop: controller_.trip(core::FaultCause::emergency_stop); break;
-      case fw::app::CommandKind::clear_fault: controller_.clear_fault(); break;
-    }
+  while (!stall_commands_ && host_.try_take_command(command)) {
+    if (static_cast<std::int32_t>(command.estops_before - estops_seen_) > 0) apply_estops(command.estops_before);
+    apply(command, loop_ns);
+  }
+  apply_estops(host_.emergency_stops());
+  if (host_.host_loss_stops() != host_loss_stops_seen_) {
+    host_loss_stops_seen_ = host_.host_loss_stops();
+    fw::app::HostCommand stop;
+    stop.kind = fw::app::CommandKind::stop;
+    apply(stop, loop_ns);
   }
   if (pending_start_ && loop_ns >= pending_start_ns_) {
     pending_start_ = false;

@@ -4,7 +4,11 @@
 // through app::HostLink exactly as ControlLoop drives it, on its own thread.
 // Prints "STARTED endcap=E true_ns=T" when a table starts, T being the table's
 // time 0 on the machine's real CLOCK_MONOTONIC (the node's clock minus its fake
-// offset), so a test can measure the start skew between end caps.
+// offset), so a test can measure the start skew between end caps; likewise
+// "ESTOPPED endcap=E true_ns=T" (the cycle that latched an emergency stop) and
+// "CLEARED endcap=E true_ns=T" (the cycle that cleared a fault). With
+// `stall_commands` it never takes a command from the mailbox (a full queue), but
+// still reads the emergency-stop counter every cycle, as ControlLoop does.
 #pragma once
 
 #include <atomic>
@@ -32,7 +36,8 @@ class OffsetClock final : public fw::Clock {
 
 class StubLoop {
  public:
-  StubLoop(int endcap, fw::app::HostLink& host, OffsetClock& clock, double rate_hz, std::uint32_t motor_count);
+  StubLoop(int endcap, fw::app::HostLink& host, OffsetClock& clock, double rate_hz, std::uint32_t motor_count,
+           bool stall_commands = false);
   ~StubLoop();
   void start();
   void stop();
@@ -40,6 +45,9 @@ class StubLoop {
  private:
   void run();
   void cycle(std::int64_t loop_ns, double dt_s);
+  void apply(const fw::app::HostCommand& command, std::int64_t loop_ns);
+  void apply_estops(std::uint32_t estops);
+  long long true_now_ns() const { return static_cast<long long>(clock_.now_ns() - clock_.offset_ns()); }
 
   int endcap_;
   fw::app::HostLink& host_;
@@ -53,6 +61,9 @@ class StubLoop {
   core::TableError ack_error_ = core::TableError::none;
   std::uint64_t cycles_ = 0;
   std::uint64_t overruns_ = 0;
+  bool stall_commands_ = false;
+  std::uint32_t estops_seen_ = 0;
+  std::uint32_t host_loss_stops_seen_ = 0;
   std::array<double, core::kMaxMotorsPerEndcap> commanded_{};
   std::atomic<bool> running_{false};
   std::thread thread_;

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 #include <vector>
 
 #include "firmware/hal/storage.hpp"
@@ -128,6 +129,32 @@ TEST_F(FileStorageTest, WriteIntoMissingDirectoryIsAnIoError) {
   FileStorage storage(dir_ / "nope");
   EXPECT_EQ(storage.write("policy", kOld), StorageResult::io_error);
   EXPECT_NE(storage.last_errno(), 0);
+}
+
+// Two threads writing one blob (the node storing a table while the main thread
+// stores one from --policy) must not share the temp file, and each reads the
+// errno of its own failure.
+TEST_F(FileStorageTest, ConcurrentWritersNeverLeaveABadBlobAndKeepTheirOwnErrno) {
+  FileStorage storage(dir_);
+  auto writer = [&storage](const std::vector<std::uint8_t>& data, int* bad) {
+    for (int i = 0; i < 200; ++i) *bad += storage.write("policy", data) == StorageResult::ok ? 0 : 1;
+  };
+  int bad_a = 0, bad_b = 0;
+  std::thread a(writer, kOld, &bad_a);
+  std::thread b(writer, kNew, &bad_b);
+  a.join();
+  b.join();
+  EXPECT_EQ(bad_a + bad_b, 0);
+  std::vector<std::uint8_t> got;
+  ASSERT_EQ(storage.read("policy", got), StorageResult::ok);
+  EXPECT_TRUE(got == kOld || got == kNew);
+  FileStorage missing(dir_ / "nope");
+  EXPECT_EQ(missing.write("policy", kOld), StorageResult::io_error);
+  EXPECT_NE(missing.last_errno(), 0);
+  int other_thread_errno = -1;
+  std::thread c([&] { other_thread_errno = missing.last_errno(); });
+  c.join();
+  EXPECT_EQ(other_thread_errno, 0) << "another thread's last error is its own (none)";
 }
 
 }  // namespace

@@ -14,7 +14,7 @@
 namespace tensegrity::interop {
 
 inline constexpr int kEndcapCount = 12;
-inline constexpr std::uint16_t kFormatVersion = 1;  // msgs::kFormatVersion
+inline constexpr std::uint16_t kFormatVersion = 2;  // msgs::kFormatVersion
 
 struct EndcapTelemetry {
   bool seen = false;

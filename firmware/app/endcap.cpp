@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "firmware/app/endcap.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <chrono>
+#include <cstring>
+
+#include "firmware/app/endcap_log.hpp"
+#include "firmware/app/policy_file.hpp"
+#include "firmware/hal/crc32.hpp"
+#include "firmware/hal/make_can_bus.hpp"
+#ifdef TENSEGRITY_ENDCAP_DDS
+#include "firmware/comms/endcap_node.hpp"
+#include "msgs/dds.hpp"
+#endif
+
+namespace tensegrity::fw::app {
+namespace {
+
+// Real-time priority when allowed (root or CAP_SYS_NICE, as the systemd unit
+// grants); otherwise the loop runs at normal priority and says so.
+void try_realtime_priority(std::thread& thread) {
+  sched_param param{};
+  param.sched_priority = 80;
+  const int rc = pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
+  if (rc != 0) log_line("SCHED_FIFO not available (%s): loop runs at normal priority", std::strerror(rc));
+}
+
+}  // namespace
+
+StoredIdentity file_policy_identity(const std::filesystem::path& policy_path, const core::EndcapTable& table) {
+  StoredIdentity identity;
+  identity.policy_id = ("file:" + policy_path.stem().string()).substr(0, kMaxStoredPolicyIdBytes);
+  identity.policy_version = 0;
+  identity.checksum = crc32(encode_table(StoredTable{0, table, {}}));
+  return identity;
+}
+
+Endcap::Endcap(EndcapOptions options) : options_(std::move(options)) { set_log_endcap_id(options_.id); }
+
+Endcap::~Endcap() { deactivate(); }
+
+void Endcap::configure() {
+  if (state_ != State::unconfigured) return;
+  try {
+    config_ = load_config(options_.config_path, options_.id);
+  } catch (const std::exception& e) {
+    throw EndcapError(e.what());
+  }
+  if (options_.start_on_boot) config_.start_on_boot = true;
+  std::error_code ec;
+  std::filesystem::create_directories(config_.storage_dir, ec);
+  if (ec) {
+    throw EndcapError(options_.config_path.string() + ": storage_dir: cannot create " + config_.storage_dir.string() +
+                      ": " + ec.message());
+  }
+  storage_ = std::make_unique<FileStorage>(config_.storage_dir);
+  store_ = std::make_unique<PolicyStore>(*storage_, config_.motor_count, config_.limits);
+  restore_or_store_table();
+  MakeCanBusResult bus = make_can_bus(config_.bus);
+  if (!bus) throw EndcapError(options_.config_path.string() + ": bus: " + bus.error);
+  bus_ = std::move(bus.bus);
+  state_ = State::inactive;
+}
+
+// The store is read once; --policy FILE replaces its record (table and identity
+// together), so a later upload is judged against what actually plays.
+void Endcap::restore_or_store_table() {
+  StoredTable stored;
+  std::string report;
+  const bool restored = store_->load(stored, report);
+  if (!report.empty()) log_line("policy store: %s", report.c_str());
+  if (!options_.policy_path.empty()) {
+    try {
+      table_ = load_endcap_table(options_.policy_path, options_.id, config_.motor_count, config_.limits);
+    } catch (const std::exception& e) {
+      throw EndcapError(e.what());
+    }
+    have_table_ = true;
+    std::string error;
+    const StoredIdentity identity = file_policy_identity(options_.policy_path, table_);
+    if (store_->save(table_, identity, error) != StorageResult::ok) {
+      log_line("could not store the policy: %s", error.c_str());
+    }
+    log_line("policy %s loaded and stored as %s", options_.policy_path.c_str(), identity.policy_id.c_str());
+  } else if (restored) {
+    table_ = stored.table;
+    have_table_ = true;
+    log_line("restored table generation %llu (%s v%u)", static_cast<unsigned long long>(stored.generation),
+             stored.identity.policy_id.empty() ? "no identity" : stored.identity.policy_id.c_str(),
+             stored.identity.policy_version);
+  } else {
+    log_line("no stored table: idle until one arrives");
+  }
+}
+
+void Endcap::start_host_link() {
+#ifdef TENSEGRITY_ENDCAP_DDS
+  if (options_.no_dds) return;
+  // The DDS node runs on its own threads and meets the loop only in mailboxes.
+  try {
+    comms::EndcapNodeConfig node_config;
+    node_config.endcap_id = options_.id;
+    node_config.domain = options_.domain >= 0 ? options_.domain : msgs::domain_id();
+    node_config.expect.motor_count = config_.motor_count;
+    node_config.expect.limits = config_.limits;
+    node_config.host_loss = comms::parse_host_loss_action(options_.host_loss);
+    if (config_.mode == LoopMode::lockstep) {
+      node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
+    }
+    node_config.link_cut = options_.link_cut;
+    node_config.loop_progress = &loop_progress_;
+    auto node = std::make_unique<comms::EndcapNode>(node_config, clock_, store_.get());
+    node->start();
+    node_ = std::move(node);
+  } catch (const std::exception& e) {
+    throw EndcapError(std::string("DDS: ") + e.what());
+  }
+#endif
+}
+
+void Endcap::activate() {
+  if (state_ != State::inactive) return;
+  start_host_link();
+  HostLink& host = node_ ? *node_ : static_cast<HostLink&>(null_host_);
+  loop_ = std::make_unique<ControlLoop>(*bus_, clock_, host, make_loop_settings(config_));
+  if (have_table_ && loop_->load_table(table_) != core::TableError::none) {
+    log_line("stored table rejected by the core");  // cannot happen: validated when stored
+  }
+  log_line("bus %s, %u motor(s), %s at %.0f Hz%s", config_.bus.c_str(), config_.motor_count, to_string(config_.mode),
+           config_.loop_rate_hz, config_.start_on_boot ? ", start on boot" : "");
+  loop_stop_.store(false);
+  loop_thread_ = std::thread([this] {
+    while (!loop_stop_.load(std::memory_order_relaxed)) {
+      if (options_.hang_loop != nullptr && options_.hang_loop->load(std::memory_order_relaxed)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the test hook: hung, until asked to exit
+        continue;
+      }
+      loop_progress_.fetch_add(1, std::memory_order_relaxed);
+      if (config_.mode == LoopMode::realtime) {
+        loop_->run_realtime_cycle();
+      } else {
+        loop_->run_lockstep_cycle(100'000'000);
+      }
+    }
+  });
+  try_realtime_priority(loop_thread_);
+  state_ = State::active;
+}
+
+void Endcap::housekeeping() {
+  AppEvent event;
+  while (loop_->pop_event(event)) log_event(event);
+  LoopStatus s;
+  if (loop_->read_status(s)) log_status(s);
+}
+
+void Endcap::run(const std::atomic<bool>& stop) {
+  if (state_ != State::active) return;
+  const auto started = std::chrono::steady_clock::now();
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    housekeeping();
+    const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (stop.load() || (options_.duration_s > 0.0 && elapsed_s >= options_.duration_s)) break;
+  }
+}
+
+void Endcap::deactivate() noexcept {
+  if (state_ != State::active) return;
+  loop_stop_.store(true);
+  if (loop_thread_.joinable()) loop_thread_.join();
+#ifdef TENSEGRITY_ENDCAP_DDS
+  if (node_) static_cast<comms::EndcapNode&>(*node_).stop();
+#endif
+  AppEvent event;
+  while (loop_->pop_event(event)) log_event(event);
+  state_ = State::inactive;
+}
+
+}  // namespace tensegrity::fw::app

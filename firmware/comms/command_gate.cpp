@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "firmware/comms/command_gate.hpp"
+
+#include "firmware/comms/wire_time.hpp"
+
+namespace tensegrity::fw::comms {
+
+const CommandGate::Answer* CommandGate::find_answer(const CommandSample& c) const {
+  for (const Answer& a : answers_) {
+    if (a.used && a.seq == c.seq && a.writer == c.writer) return &a;
+  }
+  return nullptr;
+}
+
+const CommandGate::WriterState* CommandGate::find_writer(const WriterId& w) const {
+  for (const WriterState& s : writers_) {
+    if (s.used && s.writer == w) return &s;
+  }
+  return nullptr;
+}
+
+GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clock) const {
+  GateDecision d;
+  if (endcap_id_ < 0 || endcap_id_ > 15 || (c.endcap_mask & (1U << endcap_id_)) == 0) return d;
+  if (const Answer* a = find_answer(c)) {
+    d.verdict = GateVerdict::repeat;
+    d.reason = a->reason;
+    return d;
+  }
+  d.verdict = GateVerdict::refuse;
+  if (c.format_version != format_version_) {
+    d.reason = CommandReason::wrong_format_version;
+    return d;
+  }
+  if (c.kind > static_cast<std::uint8_t>(WireCommandKind::clear_fault)) {
+    d.reason = CommandReason::unknown_kind;
+    return d;
+  }
+  d.kind = static_cast<WireCommandKind>(c.kind);
+  if (d.kind == WireCommandKind::emergency_stop) {
+    d.verdict = GateVerdict::deliver;
+    return d;
+  }
+  if (const WriterState* w = find_writer(c.writer); w != nullptr && seq_newer(w->newest_seq, c.seq)) {
+    d.reason = CommandReason::out_of_order;
+    return d;
+  }
+  if (d.kind == WireCommandKind::start) {
+    if (!valid_wire_time(c.start_host_time_ns) || !valid_wire_time(c.issued_host_time_ns)) {
+      d.reason = CommandReason::bad_time;
+      return d;
+    }
+    // Both valid wire times: the difference cannot overflow.
+    if (clock.synced && valid_wire_time(clock.host_now_ns) && clock.host_now_ns - c.issued_host_time_ns > max_age_ns_) {
+      d.reason = CommandReason::stale;
+      return d;
+    }
+  }
+  d.verdict = GateVerdict::deliver;
+  return d;
+}
+
+void CommandGate::record(const CommandSample& c, CommandReason reason) {
+  answers_[next_answer_] = Answer{c.writer, c.seq, reason, true};
+  next_answer_ = (next_answer_ + 1) % kRemembered;
+  if (reason == CommandReason::out_of_order) return;
+  ++uses_;
+  WriterState* slot = nullptr;
+  for (WriterState& s : writers_) {
+    if (s.used && s.writer == c.writer) {
+      slot = &s;
+      break;
+    }
+  }
+  if (slot == nullptr) {
+    slot = &writers_[0];  // a free slot, else the least recently used writer
+    for (WriterState& s : writers_) {
+      if (!s.used) {
+        slot = &s;
+        break;
+      }
+      if (s.last_use < slot->last_use) slot = &s;
+    }
+    *slot = WriterState{c.writer, c.seq, uses_, true};
+    return;
+  }
+  if (seq_newer(c.seq, slot->newest_seq)) slot->newest_seq = c.seq;
+  slot->last_use = uses_;
+}
+
+}  // namespace tensegrity::fw::comms

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: Apache-2.0
+// The end cap DDS node's settings (firmware/comms/endcap_node.hpp).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+#include "firmware/comms/policy_wire.hpp"
+
+namespace tensegrity::fw::comms {
+
+// The lockstep start grid in loop periods (start_grid_ns = this x the period):
+// 200 ms at 1 kHz. A 50 ms grid failed (tables 1-2 ticks apart) when the 2-core
+// host ran other real-time work at load 30 and time-sync errors exceeded 25 ms.
+inline constexpr std::int64_t kLockstepStartGridPeriods = 200;
+
+enum class HostLossAction : std::uint8_t { continue_gait = 0, stop = 1 };
+const char* to_string(HostLossAction action);
+// "continue" | "stop"; throws std::invalid_argument naming the accepted values.
+HostLossAction parse_host_loss_action(const std::string& text);
+
+struct EndcapNodeConfig {
+  int endcap_id = 0;
+  int domain = 42;
+  PolicyExpectations expect{};  // endcap_id is overwritten with `endcap_id`
+  double telemetry_rate_hz = 100.0;
+  double heartbeat_rate_hz = 5.0;
+  double time_sync_interval_s = 0.2;
+  // No host heartbeat for this long (after one was seen) is a lost host.
+  double host_timeout_s = 1.0;
+  HostLossAction host_loss = HostLossAction::continue_gait;
+  double loop_ack_timeout_s = 2.0;
+  // A start issued longer ago than this (host time) is refused as stale: it would
+  // start in the wrong phase. Only starts are judged by a clock (command_gate.hpp).
+  double command_max_age_s = 5.0;
+  bool log = true;  // one line per event to stderr
+  // Lockstep (loop time = SYNC count x period): the start grid (start_time.hpp).
+  // 0: no grid (a free-running loop maps host time directly).
+  std::int64_t start_grid_ns = 0;
+  // Fault injection (HIL): while *link_cut is true the participant's transport
+  // drops every datagram in and out (msgs/link_cut_transport.hpp). Null: never cut.
+  const std::atomic<bool>* link_cut = nullptr;
+  // Watchdog: the control loop's progress counter (bumped by the loop thread every
+  // pass, a lockstep wait for SYNC included). When it stands still for
+  // loop_stall_timeout_s the node withholds its heartbeat, so the host sees a hung
+  // loop as a silent end cap. Null: no watchdog.
+  const std::atomic<std::uint64_t>* loop_progress = nullptr;
+  double loop_stall_timeout_s = 0.5;
+};
+
+// Checks rates and timeouts; throws std::invalid_argument naming the field.
+void validate(const EndcapNodeConfig& config);
+
+}  // namespace tensegrity::fw::comms

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: Apache-2.0
+// Time-sync requests (node thread) and replies (Fast DDS's receive thread); the
+// judging is TimeSyncClient's (time_sync_client.hpp).
+#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node_dds.hpp"
+#include "tensegrity_msgs/msg/TimeSync.h"
+
+namespace tensegrity::fw::comms {
+
+namespace m = tensegrity_msgs::msg::dds_;
+
+void EndcapNode::send_time_sync_request() {
+  m::TimeSyncRequest_ req;
+  req.format_version(msgs::kFormatVersion);
+  req.endcap_id(static_cast<std::int16_t>(config_.endcap_id));
+  req.seq(++sync_sequence_);
+  {
+    std::lock_guard lock(mutex_);
+    const std::int64_t t1 = clock_.now_ns();  // as late as possible: the round trip starts here
+    req.t1_ns(t1);
+    req.nonce(sync_.start_request(t1));
+  }
+  dds_->sync_request->write(&req);
+}
+
+void EndcapNode::on_time_sync_reply(Dds& d) {
+  std::lock_guard guard(d.callback_mutex);
+  if (d.closed || d.sync_reply == nullptr) return;  // stopping, or still starting (taken next time)
+  m::TimeSyncReply_ reply;
+  dds::SampleInfo info;
+  while (d.sync_reply->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {
+    const std::int64_t t4 = clock_.now_ns();  // stamped before anything else
+    if (!info.valid_data || reply.endcap_id() != config_.endcap_id) continue;
+    if (reply.format_version() != msgs::kFormatVersion) continue;
+    std::uint64_t refused = 0;
+    {
+      std::lock_guard lock(mutex_);
+      const TimeSyncVerdict verdict = sync_.on_reply(reply.nonce(), reply.t2_ns(), reply.t3_ns(), t4);
+      if (verdict == TimeSyncVerdict::implausible) refused = sync_.counters().implausible;
+    }
+    if (refused % 100 == 1) log("refused an implausible time-sync reply (%llu so far)", static_cast<unsigned long long>(refused));
+  }
+}
+
+}  // namespace tensegrity::fw::comms

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "firmware/comms/command_gate.hpp"
+
+#include <gtest/gtest.h>
+
+#include "firmware/comms/wire_time.hpp"
+
+namespace tensegrity::fw::comms {
+namespace {
+
+constexpr std::uint16_t kVersion = 2;
+constexpr std::int64_t kMaxAge = 5'000'000'000;
+
+WriterId writer(std::uint8_t tag) {
+  WriterId w{};
+  w[0] = tag;
+  w[15] = 0x03;
+  return w;
+}
+
+CommandSample command(WireCommandKind kind, std::uint32_t seq, std::uint8_t writer_tag = 1) {
+  CommandSample c;
+  c.writer = writer(writer_tag);
+  c.format_version = kVersion;
+  c.seq = seq;
+  c.kind = static_cast<std::uint8_t>(kind);
+  c.endcap_mask = 0x0FFF;
+  c.start_host_time_ns = 10'000'000'000;
+  c.issued_host_time_ns = 9'000'000'000;
+  return c;
+}
+
+const HostClockView kSynced{true, 9'500'000'000};
+const HostClockView kNotSynced{};
+
+// Judges and records as the node does; returns the decision.
+GateDecision handle(CommandGate& gate, const CommandSample& c, const HostClockView& clock = kSynced) {
+  const GateDecision d = gate.judge(c, clock);
+  if (d.verdict == GateVerdict::refuse || d.verdict == GateVerdict::deliver) gate.record(c, d.reason);
+  return d;
+}
+
+TEST(CommandGate, IgnoresCommandsForOtherEndcaps) {
+  CommandGate gate(3, kVersion, kMaxAge);
+  CommandSample c = command(WireCommandKind::stop, 10);
+  c.endcap_mask = 0x0FF7;  // all but 3
+  EXPECT_EQ(gate.judge(c, kSynced).verdict, GateVerdict::not_addressed);
+  c.endcap_mask = 0x0008;
+  EXPECT_EQ(gate.judge(c, kSynced).verdict, GateVerdict::deliver);
+}
+
+TEST(CommandGate, ARetryGetsTheFirstAnswerAndIsNotActedOnAgain) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  const CommandSample c = command(WireCommandKind::stop, 10);
+  EXPECT_EQ(handle(gate, c).verdict, GateVerdict::deliver);
+  const GateDecision again = gate.judge(c, kSynced);
+  EXPECT_EQ(again.verdict, GateVerdict::repeat);
+  EXPECT_EQ(again.reason, CommandReason::accepted);
+  // The same seq from another writer is another command.
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 10, 2), kSynced).verdict, GateVerdict::deliver);
+}
+
+TEST(CommandGate, RefusesOtherFormatVersionsAndUnknownKinds) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  CommandSample c = command(WireCommandKind::stop, 1);
+  c.format_version = kVersion + 1;
+  EXPECT_EQ(handle(gate, c).reason, CommandReason::wrong_format_version);
+  c = command(WireCommandKind::stop, 2);
+  c.kind = 9;
+  const GateDecision d = handle(gate, c);
+  EXPECT_EQ(d.verdict, GateVerdict::refuse);
+  EXPECT_EQ(d.reason, CommandReason::unknown_kind);
+}
+
+TEST(CommandGate, OlderSequenceFromTheSameWriterIsOutOfOrderButAnEstopAlwaysPasses) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  EXPECT_EQ(handle(gate, command(WireCommandKind::clear_fault, 100)).verdict, GateVerdict::deliver);
+  const GateDecision late_stop = handle(gate, command(WireCommandKind::stop, 99));
+  EXPECT_EQ(late_stop.verdict, GateVerdict::refuse);
+  EXPECT_EQ(late_stop.reason, CommandReason::out_of_order);
+  const GateDecision late_estop = handle(gate, command(WireCommandKind::emergency_stop, 98));
+  EXPECT_EQ(late_estop.verdict, GateVerdict::deliver);
+  EXPECT_EQ(late_estop.kind, WireCommandKind::emergency_stop);
+  // Newer ones pass; another writer has its own order.
+  EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 101)).verdict, GateVerdict::deliver);
+  EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 5, 7)).verdict, GateVerdict::deliver);
+}
+
+TEST(CommandGate, SequenceOrderSurvivesWrapAround) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 0xFFFF'FFFEU)).verdict, GateVerdict::deliver);
+  EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 1)).verdict, GateVerdict::deliver);  // wrapped: newer
+  EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 0xFFFF'FFFFU)).reason, CommandReason::out_of_order);
+  EXPECT_TRUE(seq_newer(1, 0xFFFF'FFFFU));
+  EXPECT_FALSE(seq_newer(0xFFFF'FFFFU, 1));
+  EXPECT_FALSE(seq_newer(7, 7));
+}
+
+TEST(CommandGate, OnlyAStartIsJudgedByTheClock) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  // The end cap believes host time is an hour later (a forged time sync).
+  const HostClockView moved{true, 9'000'000'000 + 3'600'000'000'000};
+  const GateDecision start = handle(gate, command(WireCommandKind::start, 1), moved);
+  EXPECT_EQ(start.verdict, GateVerdict::refuse);
+  EXPECT_EQ(start.reason, CommandReason::stale);
+  for (const auto kind : {WireCommandKind::stop, WireCommandKind::emergency_stop, WireCommandKind::clear_fault}) {
+    static std::uint32_t seq = 10;
+    EXPECT_EQ(handle(gate, command(kind, ++seq), moved).verdict, GateVerdict::deliver) << static_cast<int>(kind);
+  }
+  // Before the first sync nothing is stale (the start is refused later, unsynced).
+  EXPECT_EQ(gate.judge(command(WireCommandKind::start, 100), kNotSynced).verdict, GateVerdict::deliver);
+}
+
+TEST(CommandGate, StartTimesOutsideTheWireRangeAreRefusedBeforeAnyArithmetic) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  const std::int64_t bad[] = {-1, std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max(),
+                              kMaxWireTimeNs + 1};
+  std::uint32_t seq = 1;
+  for (const std::int64_t t : bad) {
+    CommandSample c = command(WireCommandKind::start, seq++);
+    c.issued_host_time_ns = t;
+    EXPECT_EQ(gate.judge(c, kSynced).reason, CommandReason::bad_time) << t;
+    c = command(WireCommandKind::start, seq++);
+    c.start_host_time_ns = t;
+    EXPECT_EQ(gate.judge(c, kSynced).reason, CommandReason::bad_time) << t;
+  }
+}
+
+TEST(CommandGate, RemembersAnswersOfManyWritersWithinItsBounds) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  // More writers than it tracks: the oldest is forgotten, never an error.
+  for (std::uint8_t w = 0; w < 40; ++w) {
+    EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 50, w)).verdict, GateVerdict::deliver);
+  }
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 50, 39), kSynced).verdict, GateVerdict::repeat);
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 49, 39), kSynced).reason, CommandReason::out_of_order);
+}
+
+}  // namespace
+}  // namespace tensegrity::fw::comms
