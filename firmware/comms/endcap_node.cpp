@@ -109,7 +109,9 @@ bool EndcapNode::try_take_command(app::HostCommand& out) noexcept { return comma
 
 void EndcapNode::publish(const app::Telemetry& telemetry) noexcept {
   // Stamped with the node's clock so the node can map loop time <-> its own time.
-  telemetry_in_.write(StampedTelemetry{telemetry, clock_.now_ns()});
+  const std::int64_t now = clock_.now_ns();
+  telemetry_in_.write(StampedTelemetry{telemetry, now});
+  loop_clock_in_.write(LoopClockPoint{telemetry.time_ns, now});
 }
 
 ActivePolicy EndcapNode::active_policy() const {
@@ -167,9 +169,6 @@ void EndcapNode::service(std::int64_t now) {
   if (telemetry_in_.read(t)) {
     last_telemetry_ = t;
     loop_seen_ = true;
-    std::lock_guard lock(mutex_);
-    loop_point_ = LoopClockPoint{t.telemetry.time_ns, t.local_ns};
-    loop_point_valid_ = true;
   }
   handle_host_heartbeats(now);
   handle_tables(now);

@@ -131,6 +131,10 @@ class EndcapNode final : public app::HostLink {
   app::SpscRing<app::HostTable, 4> tables_;
   app::SpscRing<app::HostCommand, 16> commands_;  // producer: the command listener only
   app::LatestValue<StampedTelemetry> telemetry_in_;
+  // The loop's clock for the command listener, its own copy: a start is mapped on
+  // the receive thread, and the node thread's last telemetry may be many loop
+  // cycles old there (lockstep runs its cycles faster than the node wakes).
+  app::LatestValue<LoopClockPoint> loop_clock_in_;
   std::atomic<std::uint32_t> estops_{0};
   std::atomic<std::uint32_t> host_loss_stops_{0};
 
@@ -161,13 +165,13 @@ class EndcapNode final : public app::HostLink {
   // from more than one receive thread).
   CommandGate gate_;
   StartTimeMapper start_mapper_;
+  LoopClockPoint loop_point_{};
+  bool loop_point_valid_ = false;
 
   // Shared between the node thread and the listeners.
   mutable std::mutex mutex_;  // guards the members below
   ActivePolicy active_;
   TimeSyncClient sync_;
-  LoopClockPoint loop_point_{};
-  bool loop_point_valid_ = false;
   std::atomic<bool> host_lost_{false};
 
   std::mutex wake_mutex_;

@@ -82,6 +82,11 @@ CommandReason EndcapNode::act_on(const CommandSample& c, WireCommandKind kind) {
   app::HostCommand out;
   out.kind = static_cast<app::CommandKind>(kind);
   if (kind == WireCommandKind::start) {
+    // The loop's latest cycle, not the node thread's last look at it.
+    if (LoopClockPoint p; loop_clock_in_.read(p)) {
+      loop_point_ = p;
+      loop_point_valid_ = true;
+    }
     std::lock_guard lock(mutex_);
     if (!sync_.estimator().synced()) return CommandReason::clock_not_synced;
     if (!loop_point_valid_) return CommandReason::loop_not_running;
