@@ -179,7 +179,14 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
     throw HilError("start command over DDS not accepted: " + why);
   }
   if (config_.mode == StepperMode::realtime && ground::Station::now_ns() >= start_ns) {
-    throw HilError("start command acknowledged only after its start time (the link was too slow)");
+    double slowest_ms = 0.0;
+    int slowest = -1;
+    for (const auto& r : report.results) {
+      if (r.latency_s * 1e3 > slowest_ms) slowest_ms = r.latency_s * 1e3, slowest = r.endcap;
+    }
+    throw HilError("start command acknowledged only after its start time (the link was too slow: end cap " +
+                   std::to_string(slowest) + " acked after " + std::to_string(static_cast<int>(slowest_ms)) +
+                   " ms, the lead was " + std::to_string(static_cast<int>(config_.realtime_lead_s * 1e3)) + " ms)");
   }
   start_host_ns_ = start_ns;
   // The time sync's quality: every process here reads the same clock, so each
