@@ -94,6 +94,13 @@ void EndcapRoster::restart(int e) {
   processes_.restart(e);
   ec.state = EndcapState::waiting_process;
   ec.first_answer_pending = true;
+  ec.awaited = true;  // a new program
+}
+
+std::string EndcapRoster::freeze(int e, bool loop_only) {
+  std::string why = processes_.freeze(e, loop_only);
+  if (why.empty()) endcaps_[e].awaited = false;
+  return why;
 }
 
 bool EndcapRoster::all_at_gate() const {

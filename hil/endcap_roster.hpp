@@ -32,6 +32,14 @@ class EndcapProcesses {
   // Cuts (up = false) or restores the end cap's DDS link to the host. Returns why
   // it was not done ("" when done): no DDS link in this run, not running, ...
   virtual std::string set_dds_link(int endcap, bool up) = 0;
+  // Fault injection: SIGSTOP the program (a dead end cap, nothing of it runs), or
+  // with loop_only hang its control loop alone (the test hook --hang-loop-signal).
+  // Returns why it was not done ("" when done).
+  virtual std::string freeze(int endcap, bool loop_only) {
+    (void)endcap;
+    (void)loop_only;
+    return "not supported by this launcher";
+  }
 };
 
 enum class EndcapState : std::uint8_t {
@@ -84,6 +92,10 @@ class EndcapRoster {
   // The scenario's kill and restart (the bus side is the caller's).
   void kill(int endcap);
   void restart(int endcap);
+  // stop_endcap, hang_loop: its bus and devices keep running, the barrier no
+  // longer waits for it. Returns why not ("" when done).
+  std::string freeze(int endcap, bool loop_only);
+  bool awaited(int endcap) const { return endcaps_[endcap].awaited; }
 
   // --- the start gate ---
   bool all_at_gate() const;
@@ -107,6 +119,8 @@ class EndcapRoster {
     EndcapState state = EndcapState::waiting_process;
     bool first_answer_pending = true;
     bool expected = false;  // a SYNC went out this tick: wait for its RPDO1s
+    // False once the scenario froze it (stop_endcap, hang_loop).
+    bool awaited = true;
   };
   // Admits end cap `e` if its program listens; returns whether it is live.
   bool admit(int e);

@@ -27,6 +27,8 @@ void LiveFaultTarget::restart(int endcap) {
   roster_.restart(endcap);
 }
 
+std::string LiveFaultTarget::freeze(int endcap, bool loop_only) { return roster_.freeze(endcap, loop_only); }
+
 std::string LiveFaultTarget::set_dds_link(int endcap, bool up) { return roster_.processes().set_dds_link(endcap, up); }
 
 void FaultInjector::apply_due(std::int64_t step, std::int64_t now_ns, FaultTarget& target,
@@ -52,6 +54,19 @@ void FaultInjector::apply(const ScenarioEvent& ev, std::int64_t step, std::int64
     case FaultKind::load_cell_drift: target.devices(e).start_load_cell_drift(ev.params.n_per_s, now_ns); break;
     case FaultKind::drop_frames:
     case FaultKind::corrupt_frames: start_frame_fault(ev, step, target); break;
+    case FaultKind::reboot_drive: apply_to_motors(ev, now_ns, target); break;
+    case FaultKind::reboot_load_cell:
+      target.devices(e).reboot_load_cell(now_ns, out_);
+      target.send(e, out_);  // the boot-up, ahead of this tick's PDOs
+      out_.clear();
+      break;
+    case FaultKind::hang_loop:
+    case FaultKind::stop_endcap:
+      if (const std::string why = target.freeze(e, ev.fault == FaultKind::hang_loop); !why.empty()) {
+        log.push_back(ev.describe() + ": not done: " + why);
+        return;
+      }
+      break;
     case FaultKind::kill_endcap: target.kill(e); break;
     case FaultKind::restart_endcap: target.restart(e); break;
   }
@@ -69,6 +84,7 @@ void FaultInjector::apply_to_motors(const ScenarioEvent& ev, std::int64_t now_ns
       case FaultKind::drive_silent: devices.silence_drive(m, true); break;
       case FaultKind::release_spool: devices.release_spool(m); break;
       case FaultKind::seize_spool: devices.seize_spool(m); break;
+      case FaultKind::reboot_drive: devices.reboot_drive(m, now_ns, out_); break;
       default: break;
     }
   }

@@ -19,6 +19,7 @@ nlohmann::json to_json(const HilResult& r) {
                        {"host_losses", s.host_losses},
                        {"host_returns", s.host_returns},
                        {"dds_link_cuts", s.link_cuts},
+                       {"loop_stalls", s.loop_stalls},
                        {"exit_status", s.exit_status},
                        {"cpu_s", s.cpu_s},
                        {"restarts", s.restarts},

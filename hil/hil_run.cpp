@@ -262,6 +262,7 @@ EndcapSummary summarize(const EndcapProcessReport& r, const RunParts& parts) {
   s.host_losses = count_lines(log, "host LOST");
   s.host_returns = count_lines(log, "host back");
   s.link_cuts = count_lines(log, "DDS link CUT");
+  s.loop_stalls = count_lines(log, "control loop STALLED");
   return s;
 }
 

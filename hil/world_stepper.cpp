@@ -96,9 +96,9 @@ bool WorldStepper::pass_gate(int e) {
 void WorldStepper::lockstep_tick(bool physics) {
   source_.check_stop();
   for (int e = 0; e < endcap_count(); ++e) {
-    const bool expected = roster_.live(e) && pass_gate(e);
-    roster_.expect(e, expected);
-    if (!expected) continue;
+    const bool ticked = roster_.live(e) && pass_gate(e);
+    roster_.expect(e, ticked && roster_.awaited(e));  // a frozen one's bus runs on, unawaited
+    if (!ticked) continue;
     send_tick(e, true);
     roster_.devices(e).clear_rpdo_marks();
   }

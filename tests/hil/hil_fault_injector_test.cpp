@@ -32,6 +32,10 @@ class RecordingTarget final : public FaultTarget {
     actions.push_back(std::string(up ? "link up " : "link cut ") + std::to_string(e));
     return e == 1 ? "not running" : "";
   }
+  std::string freeze(int e, bool loop_only) override {
+    actions.push_back(std::string(loop_only ? "hang " : "stop ") + std::to_string(e));
+    return "";
+  }
   std::vector<std::string> actions;
 
  private:
