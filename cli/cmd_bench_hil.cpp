@@ -9,18 +9,19 @@
 // (all of them busy with the HIL and nothing else: an upper bound).
 #include <algorithm>
 #include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
+#include <stop_token>
 #include <thread>
 #include <unistd.h>
 
 #include "cli/commands.hpp"
 #include "cli/run_cpu.hpp"
 #include "cli/shipped_policy.hpp"
+#include "cli/stop_signals.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
@@ -96,8 +97,6 @@ class RunSampler {
   bool complete_ = false;
 };
 
-extern "C" void on_bench_stop_signal(int) { hil::request_stop(); }
-
 double s_of(std::int64_t ns) { return static_cast<double>(ns) * 1e-9; }
 
 nlohmann::json RunSampler::report(double dt_s) const {
@@ -145,8 +144,10 @@ struct ModeResult {
   nlohmann::json cpu;
 };
 
-ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double duration_s, double dt_s) {
+ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double duration_s, double dt_s,
+                    std::stop_token stop) {
   hil::HilOptions o;
+  o.stop = std::move(stop);
   o.policy = shipped_policy_or(args.policy);
   o.endcap_binary = args.endcap;
   o.duration_s = duration_s;
@@ -240,8 +241,7 @@ void print_cpu(const nlohmann::json& c) {
 
 void run_bench_hil(const BenchHilArgs& args) {
   // Ctrl-C ends a run in order: the end caps are shut down, the temp dir removed.
-  std::signal(SIGINT, on_bench_stop_signal);
-  std::signal(SIGTERM, on_bench_stop_signal);
+  const StopOnSignals stop;
   const std::filesystem::path policy_path = shipped_policy_or(args.policy);
   const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(policy_path));
   const double dt_s = robot.time_step_s;
@@ -254,8 +254,8 @@ void run_bench_hil(const BenchHilArgs& args) {
   // First, with nothing of ours running: what the kernel and hypervisor cost a 1 kHz loop.
   std::optional<hil::TimerProbeResult> probe;
   if (args.probe_s > 0) probe = hil::probe_timer_latency(args.probe_s);
-  const ModeResult lock = run_mode(args, hil::StepperMode::lockstep, args.lockstep_s, dt_s);
-  const ModeResult real = run_mode(args, hil::StepperMode::realtime, args.realtime_s, dt_s);
+  const ModeResult lock = run_mode(args, hil::StepperMode::lockstep, args.lockstep_s, dt_s, stop.token());
+  const ModeResult real = run_mode(args, hil::StepperMode::realtime, args.realtime_s, dt_s, stop.token());
   const nlohmann::json j = {{"benchmark", "hil"},
                             {"policy", policy_path.string()},
                             {"provision", args.provision},

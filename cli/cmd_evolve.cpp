@@ -78,10 +78,7 @@ RobotArg read_robot_arg(const std::string& arg) {
   }
 }
 
-// `mpi` is rank 0's side of an MPI run; null: evaluate on this machine's threads.
-void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
-  const RobotArg robot_arg = read_robot_arg(args.robot);
-  const sim::Robot& robot = robot_arg.robot;
+sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot& robot) {
   sim::evolve::EvolveConfig config;
   try {
     config.method = sim::evolve::parse_fitness_method(args.method);
@@ -112,6 +109,137 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   } catch (const sim::evolve::ConfigError& e) {
     throw CommandError(2, e.what());
   }
+  return config;
+}
+
+// The best team as a policy file, with how it was made.
+sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig& config,
+                        const sim::evolve::Coevolution& evo, double score_m) {
+  sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, evo.best().team);
+  policy.provenance.method = sim::evolve::to_string(config.method);
+  policy.provenance.seed = config.seed;
+  policy.provenance.episodes = evo.episodes();
+  policy.provenance.score_m = score_m;
+  policy.provenance.robot_hash = robot.hash;
+  policy.provenance.mutation = sim::evolve::to_string(config.mutation);
+  policy.provenance.sigma_m = config.sigma_m;
+  policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
+  policy.provenance.anneal_episodes = config.anneal_episodes;
+  policy.provenance.anneal_start_episodes = config.anneal_episodes > 0 ? config.anneal_start_episodes : 0;
+  return policy;
+}
+
+// The gait's strut spin and ground contacts, from one more episode of the policy
+// through the control core: every learned gait reports whether it rolls or skates.
+sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveConfig& config,
+                             sim::Policy& policy) {
+  sim::CoreController controller(robot, policy);
+  sim::EpisodeOptions episode;
+  episode.duration_s = config.duration_s;
+  const sim::EpisodeResult gait = sim::run_episode(robot, controller, episode);
+  policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
+  policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
+  policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
+  return gait;
+}
+
+// What the summary shows beside the evolution itself.
+struct EvolveOutcome {
+  sim::evolve::DriverResult result;
+  sim::evolve::TeamResult final_result;
+  double wall_s = 0.0;
+  int threads = 0;
+  sim::EpisodeResult gait;
+};
+
+void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveOutcome& o,
+                EvolveMpi* mpi) {
+  const auto& evo = o.result.evolution;
+  const std::int64_t episodes_here = evo.episodes() - o.result.resumed_episodes;
+  nlohmann::json j = {{"best_score_m", evo.best().score_m},
+                      {"best_feasible", evo.best().feasible},
+                      {"final_score_m", o.final_result.score_m},
+                      {"final_feasible", o.final_result.feasible},
+                      {"episodes", evo.episodes()},
+                      {"generations", evo.generation()},
+                      {"infeasible_rate_last", evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate()},
+                      {"resumed", o.result.resumed},
+                      {"threads", o.threads},
+                      {"ranks", mpi != nullptr ? mpi->ranks() : 1},
+                      {"wall_time_s", o.wall_s},
+                      {"episodes_per_s", o.wall_s > 0.0 ? static_cast<double>(episodes_here) / o.wall_s : 0.0},
+                      {"out", args.out},
+                      {"log", args.log},
+                      {"config", sim::evolve::config_to_json(config)},
+                      {"gait",
+                       {{"axial_spin_rms_rad_per_s", o.gait.axial_spin_rms_rad_per_s},
+                        {"axial_spin_max_rad_per_s", o.gait.axial_spin_max_rad_per_s},
+                        {"endcaps_touched_ground", o.gait.endcaps_touched_ground}}}};
+  if (mpi != nullptr) j["rank_loads"] = mpi->loads();
+  std::printf("%s\n", j.dump(2).c_str());
+}
+
+void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveOutcome& o,
+                EvolveMpi* mpi) {
+  const auto& evo = o.result.evolution;
+  const auto& best = evo.best();
+  const std::int64_t episodes_here = evo.episodes() - o.result.resumed_episodes;
+  const double rate = o.wall_s > 0.0 ? static_cast<double>(episodes_here) / o.wall_s : 0.0;
+  const double infeasible_last = evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate();
+  std::printf("evolve %s: %d generations, %lld episodes%s\n", sim::evolve::to_string(config.method),
+              evo.generation(), static_cast<long long>(evo.episodes()), o.result.resumed ? " (resumed)" : "");
+  std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
+              o.final_result.score_m, o.final_result.feasible ? "" : " INFEASIBLE");
+  std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
+  std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
+              o.gait.axial_spin_rms_rad_per_s, o.gait.axial_spin_max_rad_per_s, o.gait.endcaps_touched_ground);
+  std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", o.wall_s, rate, o.threads);
+  if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
+  std::printf("\n");
+  if (mpi != nullptr) {
+    for (const auto& r : mpi->loads()) {
+      std::printf("    rank %d  %-20s %3d threads  %lld teams\n", r["rank"].get<int>(),
+                  r["host"].get<std::string>().c_str(), r["threads"].get<int>(), r["teams"].get<long long>());
+    }
+  }
+  std::printf("  policy     %s\n  curve      %s\n", args.out.c_str(), args.log.c_str());
+}
+
+// Evolves to the budget (or from the checkpoint on), then evaluates the best team
+// once more, alone: its score and feasibility as the policy file reports them (the
+// model is deterministic, so this confirms the recorded score).
+EvolveOutcome evolve(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
+                     sim::evolve::Evaluator& evaluator) {
+  EvolveProgress progress(isatty(STDERR_FILENO) == 1, config.episodes);
+  sim::evolve::DriverOptions options;
+  options.checkpoint_dir = args.checkpoint;
+  options.resume = args.resume;
+  options.curve_csv = args.log;
+  options.on_generation = [&](const sim::evolve::Coevolution& evo, const sim::evolve::GenerationStats& stats) {
+    progress.update(evo, stats);
+  };
+  const auto started = std::chrono::steady_clock::now();
+  EvolveOutcome o{[&] {
+                    try {
+                      return sim::evolve::drive(config, evaluator, options);
+                    } catch (const sim::evolve::CheckpointError& e) {
+                      throw CommandError(3, e.what());
+                    }
+                  }(),
+                  sim::evolve::TeamResult{}, 0.0, 0};
+  progress.finish();
+  for (const auto& w : o.result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
+  const std::vector<sim::evolve::Team> final_team{o.result.evolution.best().team};
+  o.final_result = evaluator.evaluate(final_team).front();
+  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return o;
+}
+
+// `mpi` is rank 0's side of an MPI run; null: evaluate on this machine's threads.
+void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
+  const RobotArg robot_arg = read_robot_arg(args.robot);
+  const sim::Robot& robot = robot_arg.robot;
+  const sim::evolve::EvolveConfig config = evolve_config(args, robot);
 
   // Hours of evolution must not end in "cannot write": make the output's directory now.
   const std::filesystem::path out_path(args.out);
@@ -125,101 +253,16 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   }
   sim::evolve::Evaluator& evaluator = mpi != nullptr ? mpi->evaluator(robot_arg.text, robot, config) : *threaded;
   if (mpi != nullptr) threads = mpi->threads();
-  EvolveProgress progress(isatty(STDERR_FILENO) == 1, config.episodes);
 
-  sim::evolve::DriverOptions options;
-  options.checkpoint_dir = args.checkpoint;
-  options.resume = args.resume;
-  options.curve_csv = args.log;
-  options.on_generation = [&](const sim::evolve::Coevolution& evo, const sim::evolve::GenerationStats& stats) {
-    progress.update(evo, stats);
-  };
-  const auto started = std::chrono::steady_clock::now();
-  sim::evolve::DriverResult result = [&] {
-    try {
-      return sim::evolve::drive(config, evaluator, options);
-    } catch (const sim::evolve::CheckpointError& e) {
-      throw CommandError(3, e.what());
-    }
-  }();
-  progress.finish();
-  for (const auto& w : result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
-
-  const auto& evo = result.evolution;
-  const auto& best = evo.best();
-  // The best team once more, alone: its score and feasibility as the policy file
-  // reports them (the model is deterministic, so this confirms the recorded score).
-  const std::vector<sim::evolve::Team> final_team{best.team};
-  const sim::evolve::TeamResult final_result = evaluator.evaluate(final_team).front();
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-
-  sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, best.team);
-  policy.provenance.method = sim::evolve::to_string(config.method);
-  policy.provenance.seed = config.seed;
-  policy.provenance.episodes = evo.episodes();
-  policy.provenance.score_m = final_result.score_m;
-  policy.provenance.robot_hash = robot.hash;
-  policy.provenance.mutation = sim::evolve::to_string(config.mutation);
-  policy.provenance.sigma_m = config.sigma_m;
-  policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
-  policy.provenance.anneal_episodes = config.anneal_episodes;
-  policy.provenance.anneal_start_episodes = config.anneal_episodes > 0 ? config.anneal_start_episodes : 0;
-  // The gait's strut spin and ground contacts, from one more episode of the policy
-  // through the control core: every learned gait reports whether it rolls or skates.
-  const sim::EpisodeResult gait = [&] {
-    sim::CoreController controller(robot, policy);
-    sim::EpisodeOptions episode;
-    episode.duration_s = config.duration_s;
-    return sim::run_episode(robot, controller, episode);
-  }();
-  policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
-  policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
-  policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
+  EvolveOutcome outcome = evolve(args, config, evaluator);
+  outcome.threads = threads;
+  sim::Policy policy = best_policy(robot, config, outcome.result.evolution, outcome.final_result.score_m);
+  outcome.gait = play_gait(robot, config, policy);
   sim::save_policy(args.out, policy);
-
-  const std::int64_t episodes_here = evo.episodes() - result.resumed_episodes;
-  const double rate = wall_s > 0.0 ? static_cast<double>(episodes_here) / wall_s : 0.0;
-  const double infeasible_last = evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate();
   if (args.json) {
-    nlohmann::json j = {{"best_score_m", best.score_m},
-                              {"best_feasible", best.feasible},
-                              {"final_score_m", final_result.score_m},
-                              {"final_feasible", final_result.feasible},
-                              {"episodes", evo.episodes()},
-                              {"generations", evo.generation()},
-                              {"infeasible_rate_last", infeasible_last},
-                              {"resumed", result.resumed},
-                              {"threads", threads},
-                              {"ranks", mpi != nullptr ? mpi->ranks() : 1},
-                              {"wall_time_s", wall_s},
-                              {"episodes_per_s", rate},
-                              {"out", args.out},
-                              {"log", args.log},
-                              {"config", sim::evolve::config_to_json(config)},
-                              {"gait",
-                               {{"axial_spin_rms_rad_per_s", gait.axial_spin_rms_rad_per_s},
-                                {"axial_spin_max_rad_per_s", gait.axial_spin_max_rad_per_s},
-                                {"endcaps_touched_ground", gait.endcaps_touched_ground}}}};
-    if (mpi != nullptr) j["rank_loads"] = mpi->loads();
-    std::printf("%s\n", j.dump(2).c_str());
+    print_json(args, config, outcome, mpi);
   } else {
-    std::printf("evolve %s: %d generations, %lld episodes%s\n", policy.provenance.method.c_str(), evo.generation(),
-                static_cast<long long>(evo.episodes()), result.resumed ? " (resumed)" : "");
-    std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
-                final_result.score_m, final_result.feasible ? "" : " INFEASIBLE");
-    std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
-    std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
-                gait.axial_spin_rms_rad_per_s, gait.axial_spin_max_rad_per_s, gait.endcaps_touched_ground);
-    std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", wall_s, rate, threads);
-    if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
-    std::printf("\n");
-    if (mpi != nullptr) {
-      for (const auto& r : mpi->loads()) {
-        std::printf("    rank %d  %-20s %3d threads  %lld teams\n", r["rank"].get<int>(),
-                    r["host"].get<std::string>().c_str(), r["threads"].get<int>(), r["teams"].get<long long>());
-      }
-    }
-    std::printf("  policy     %s\n  curve      %s\n", args.out.c_str(), args.log.c_str());
+    print_text(args, config, outcome, mpi);
   }
 }
 

@@ -4,7 +4,6 @@
 // cmd_bench_hil.cpp.
 #include <sys/resource.h>
 
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,6 +11,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/shipped_policy.hpp"
+#include "cli/stop_signals.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "sim/core_controller.hpp"
@@ -41,14 +41,6 @@ struct HilArgs {
   bool keep = false;
   bool json = false;
 };
-
-extern "C" void on_stop_signal(int) { hil::request_stop(); }
-
-// Ctrl-C ends the run in order: the children are shut down, the temp dir removed.
-void install_stop_handlers() {
-  std::signal(SIGINT, on_stop_signal);
-  std::signal(SIGTERM, on_stop_signal);
-}
 
 hil::HilOptions make_options(const HilArgs& a) {
   hil::HilOptions o;
@@ -81,8 +73,11 @@ hil::HilOptions make_options(const HilArgs& a) {
 }
 
 void run_hil_command(const HilArgs& args) {
-  install_stop_handlers();
-  const hil::HilResult r = hil::run_hil(make_options(args));
+  // Ctrl-C ends the run in order: the children are shut down, the temp dir removed.
+  const StopOnSignals stop;
+  hil::HilOptions options = make_options(args);
+  options.stop = stop.token();
+  const hil::HilResult r = hil::run_hil(options);
   if (args.json) {
     std::printf("%s\n", hil::to_json(r).dump(2).c_str());
   } else {

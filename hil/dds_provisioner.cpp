@@ -88,37 +88,28 @@ std::vector<std::string> DdsProvisioner::log() const {
   return log_;
 }
 
-void DdsProvisioner::deliver(StartHandshake& handshake) {
-  normal_priority();
-  const int n = robot_.endcap_count();
-  const auto mask = static_cast<std::uint16_t>((1U << n) - 1U);
-  const std::int64_t t0 = ground::Station::now_ns();
-
-  // 1. Everyone on the link with a synchronized clock (a start needs one).
-  if (!station_->wait_for_endcaps(mask, true, t0 + to_ns(config_.discovery_timeout_s))) {
-    std::vector<int> missing, unsynced;
-    const auto status = station_->snapshot();
-    for (int e = 0; e < n; ++e) {
-      if (!status[e].seen) {
-        missing.push_back(e);
-      } else if (!status[e].heartbeat.clock_synced()) {
-        unsynced.push_back(e);
-      }
+// 1. Everyone on the link with a synchronized clock (a start needs one).
+void DdsProvisioner::await_endcaps(std::uint16_t mask, std::int64_t deadline_ns) {
+  if (station_->wait_for_endcaps(mask, true, deadline_ns)) return;
+  std::vector<int> missing, unsynced;
+  const auto status = station_->snapshot();
+  for (int e = 0; e < robot_.endcap_count(); ++e) {
+    if (!status[e].seen) {
+      missing.push_back(e);
+    } else if (!status[e].heartbeat.clock_synced()) {
+      unsynced.push_back(e);
     }
-    char within[64];
-    std::snprintf(within, sizeof within, "DDS: within %.1f s", config_.discovery_timeout_s);
-    std::string why = within;
-    if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
-    if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
-    throw HilError(why + " (see their logs)");
   }
-  const std::int64_t t_found = ground::Station::now_ns();
+  char within[64];
+  std::snprintf(within, sizeof within, "DDS: within %.1f s", config_.discovery_timeout_s);
+  std::string why = within;
+  if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
+  if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
+  throw HilError(why + " (see their logs)");
+}
 
-  // 2. The policy, as `tensegrity upload` sends it.
-  fw::comms::PolicyIdentity identity;
-  identity.policy_id = policy_id_;
-  identity.policy_version = static_cast<std::uint32_t>(std::time(nullptr));
-  identity.robot = robot_.name;
+// 2. The policy, as `tensegrity upload` sends it. Returns the slowest acknowledgement.
+double DdsProvisioner::upload_policy(const fw::comms::PolicyIdentity& identity, double& total_s) {
   const auto tables = ground::policy_messages(policy_, robot_, identity, ground::random_sequence_base());
   ground::UploadOptions uo;
   uo.timeout_s = config_.upload_timeout_s;
@@ -132,44 +123,47 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
     }
     throw HilError("policy upload over DDS incomplete: " + why);
   }
-  double worst_ms = 0.0;
-  for (const auto& r : upload.results) worst_ms = std::max(worst_ms, r.latency_s * 1e3);
+  double worst_s = 0.0;
+  for (const auto& r : upload.results) worst_s = std::max(worst_s, r.latency_s);
+  total_s = upload.total_s;
+  return worst_s;
+}
 
-  // Real time: an end cap armed early in the boot may have latched a sensor
-  // timeout while the emulator was busy starting the others. Cleared, and said.
-  if (!clear_faults_before_start(mask, ground::Station::now_ns() + to_ns(config_.command_timeout_s))) {
-    std::string why;
-    const auto status = station_->snapshot();
-    for (int e = 0; e < n; ++e) {
-      if (status[e].heartbeat.fault() != 0) {
-        why += (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
-      }
+// Real time: an end cap armed early in the boot may have latched a sensor
+// timeout while the emulator was busy starting the others. Cleared, and said.
+void DdsProvisioner::clear_faults_or_fail(std::uint16_t mask) {
+  if (clear_faults_before_start(mask, ground::Station::now_ns() + to_ns(config_.command_timeout_s))) return;
+  std::string why;
+  const auto status = station_->snapshot();
+  for (int e = 0; e < robot_.endcap_count(); ++e) {
+    if (status[e].heartbeat.fault() != 0) {
+      why += (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
     }
-    throw HilError("end cap(s) " + why + " still faulted after a clear-fault before the start");
   }
+  throw HilError("end cap(s) " + why + " still faulted after a clear-fault before the start");
+}
 
-  // 3. One start time for all, once every clock is known well enough to place it.
-  const double settle_rt_ms =
-      settle_time_sync(mask, ground::Station::now_ns() + to_ns(config_.sync_settle_timeout_s)) * 1e3;
+// 3. One start time for all. Lockstep: k ticks after the last SYNC (plus half the
+// window in which the end caps ran it): each end cap rounds the host time since
+// its last cycle to its start grid, so its mapping error (time sync, wake-up) may
+// be up to half a grid step. Real time: a little ahead of now.
+std::int64_t DdsProvisioner::place_start(StartHandshake& handshake, std::string& how) {
+  if (config_.mode == StepperMode::lockstep) {
+    const FrozenTick frozen = handshake.freeze(ground::Station::now_ns() + 10 * kNsPerS);
+    how = "SYNC +" + std::to_string(config_.start_after_ticks) + " after the freeze (last tick answered in " +
+          std::to_string((frozen.answered_ns - frozen.sent_ns) / 1000) + " us)";
+    return frozen.sent_ns + config_.start_after_ticks * kTickNs + (frozen.answered_ns - frozen.sent_ns) / 2;
+  }
+  char in[48];
+  std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);
+  how = in;
+  return ground::Station::now_ns() + to_ns(config_.realtime_lead_s);
+}
+
+void DdsProvisioner::send_start(std::uint16_t mask, std::int64_t start_ns) {
   ground::CommandOptions co;
   co.endcap_mask = mask;
   co.timeout_s = config_.command_timeout_s;
-  std::int64_t start_ns = 0;
-  std::string how;
-  if (config_.mode == StepperMode::lockstep) {
-    const FrozenTick frozen = handshake.freeze(ground::Station::now_ns() + 10 * kNsPerS);
-    // k ticks after the last SYNC (plus half the window in which the end caps ran
-    // it): each end cap rounds the host time since its last cycle to its start grid,
-    // so its mapping error (time sync, wake-up) may be up to half a grid step.
-    start_ns = frozen.sent_ns + config_.start_after_ticks * kTickNs + (frozen.answered_ns - frozen.sent_ns) / 2;
-    how = "SYNC +" + std::to_string(config_.start_after_ticks) + " after the freeze (last tick answered in " +
-          std::to_string((frozen.answered_ns - frozen.sent_ns) / 1000) + " us)";
-  } else {
-    start_ns = ground::Station::now_ns() + to_ns(config_.realtime_lead_s);
-    char in[48];
-    std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);
-    how = in;
-  }
   const ground::CommandReport report = ground::send_command(*station_, ground::CommandKind::start, start_ns, co);
   if (!report.all_accepted()) {
     std::string why;
@@ -188,6 +182,30 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
                    std::to_string(slowest) + " acked after " + std::to_string(static_cast<int>(slowest_ms)) +
                    " ms, the lead was " + std::to_string(static_cast<int>(config_.realtime_lead_s * 1e3)) + " ms)");
   }
+}
+
+void DdsProvisioner::deliver(StartHandshake& handshake) {
+  normal_priority();
+  const int n = robot_.endcap_count();
+  const auto mask = static_cast<std::uint16_t>((1U << n) - 1U);
+  const std::int64_t t0 = ground::Station::now_ns();
+  await_endcaps(mask, t0 + to_ns(config_.discovery_timeout_s));
+  const std::int64_t t_found = ground::Station::now_ns();
+
+  fw::comms::PolicyIdentity identity;
+  identity.policy_id = policy_id_;
+  identity.policy_version = static_cast<std::uint32_t>(std::time(nullptr));
+  identity.robot = robot_.name;
+  double upload_s = 0.0;
+  const double worst_ack_s = upload_policy(identity, upload_s);
+  clear_faults_or_fail(mask);
+
+  // Once every clock is known well enough to place the start.
+  const double settle_rt_ms =
+      settle_time_sync(mask, ground::Station::now_ns() + to_ns(config_.sync_settle_timeout_s)) * 1e3;
+  std::string how;
+  const std::int64_t start_ns = place_start(handshake, how);
+  send_start(mask, start_ns);
   start_host_ns_ = start_ns;
   // The time sync's quality: every process here reads the same clock, so each
   // end cap's offset estimate is its error.
@@ -203,7 +221,7 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
                 "start at host time %.6f s (%s); time sync at the start: worst round trip %.3f ms; at the end of "
                 "the hold: worst offset %.3f ms, worst round trip %.3f ms",
                 n, lease_.domain(), static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(),
-                identity.policy_version, upload.total_s * 1e3, worst_ms, static_cast<double>(start_ns) * 1e-9,
+                identity.policy_version, upload_s * 1e3, worst_ack_s * 1e3, static_cast<double>(start_ns) * 1e-9,
                 how.c_str(), settle_rt_ms, worst_offset_ms, worst_round_trip_ms);
   note(line);
   if (config_.mode == StepperMode::lockstep) {

@@ -84,6 +84,12 @@ class DdsProvisioner final : public Provisioner {
   int domain() const { return lease_.domain(); }
 
  private:
+  // deliver()'s steps.
+  void await_endcaps(std::uint16_t mask, std::int64_t deadline_ns);
+  double upload_policy(const fw::comms::PolicyIdentity& identity, double& total_s);
+  void clear_faults_or_fail(std::uint16_t mask);
+  std::int64_t place_start(StartHandshake& handshake, std::string& how);
+  void send_start(std::uint16_t mask, std::int64_t start_ns);
   void supervise();
   // End caps of `mask` that report a latched fault get one clear-fault (the
   // operator's `tensegrity clear-fault` before a start), logged; returns false if

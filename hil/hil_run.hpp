@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,9 @@ struct HilOptions {
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).
   std::function<void(ProcessLauncher&)> after_launch;
   std::function<void(const WorldStepper&, ProcessLauncher&)> after_step;
+  // A stop requested here (Ctrl-C in the launcher) ends the run in order with
+  // "interrupted": the end caps are shut down, the run directory removed.
+  std::stop_token stop;
 };
 
 struct EndcapSummary {

@@ -6,7 +6,7 @@
 #include <cerrno>
 #include <ctime>
 
-#include "hil/hil_error.hpp"
+#include "hil/clock.hpp"
 
 namespace tensegrity::hil {
 

@@ -3,6 +3,7 @@
 
 #include <chrono>
 
+#include "hil/clock.hpp"
 #include "hil/hil_error.hpp"
 
 namespace tensegrity::hil {

@@ -5,7 +5,7 @@
 
 #include "hil/pacer.hpp"
 #include "hil/realtime_priority.hpp"
-#include "hil/hil_error.hpp"
+#include "hil/clock.hpp"
 
 namespace tensegrity::hil {
 

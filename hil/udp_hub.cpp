@@ -8,29 +8,16 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
 
 #include "firmware/drivers/cob_id.hpp"
 #include "firmware/hal/udp_can_wire.hpp"
+#include "hil/clock.hpp"
 #include "hil/hil_error.hpp"
 
 namespace tensegrity::hil {
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-namespace {
-std::atomic<bool> g_stop{false};
-}  // namespace
-
-void request_stop() { g_stop.store(true); }
-bool stop_requested() { return g_stop.load(std::memory_order_relaxed); }
 
 namespace {
 constexpr std::size_t kBatch = 64;  // datagrams per sendmmsg / recvmmsg

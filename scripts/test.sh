@@ -14,6 +14,8 @@ preset="${TENSEGRITY_TEST_PRESET:-default}"
 start=$(date +%s)
 cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" -j "$(nproc)"
+# No source file over 400 lines, no function over 80 (scripts/size-exceptions.txt).
+python3 scripts/check_size.py -p "build/$preset" --self-test
 ctest --preset "$preset"
 echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
 # Every decoder of outside input under libFuzzer: corpora and recorded crashes

@@ -14,6 +14,7 @@
 #include "firmware/drivers/cob_id.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
 #include "hil/answer_nap.hpp"
+#include "hil/clock.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/lateness.hpp"
 #include "hil/process_launcher.hpp"
