@@ -189,6 +189,10 @@ void ProcessLauncher::spawn(int e, bool restart) {
     ::sched_setscheduler(0, SCHED_OTHER, &normal);
     ::dup2(log_fd, 1);
     ::dup2(log_fd, 2);
+    // Nothing else of the launcher's: its DDS participant's sockets (Fast DDS does
+    // not open them close-on-exec) stayed bound in every end cap, beyond the
+    // launcher's own life.
+    ::close_range(3, ~0U, 0);
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
