@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """Helpers of the view's browser test: headless Chromium through Debian's
 chromium-driver, processes that are always stopped, free ports."""
-import contextlib
 import os
 import signal
 import socket
@@ -73,10 +72,14 @@ def wait_for(what, predicate, timeout, interval=0.1):
     end = time.monotonic() + timeout
     last = None
     while time.monotonic() < end:
-        with contextlib.suppress(Exception):
+        try:
             last = predicate()
             if last:
                 return last
+        except AssertionError:
+            raise  # the predicate's own verdict (a process that died)
+        except Exception as e:  # the page not there yet
+            last = e
         time.sleep(interval)
     raise AssertionError(f"timed out after {timeout} s waiting for {what} (last: {last!r})")
 

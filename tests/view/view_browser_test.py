@@ -100,13 +100,17 @@ def hil_domain(log_path):
 def test_live(args, driver, tmp):
     port = free_port()
     hil_log = os.path.join(tmp, "hil.log")
-    with Process([args.tensegrity, "hil", "--duration", "300", "--endcap", args.endcap, "--view", "--view-port",
-                  str(port), "--view-wait", "120"], hil_log) as hil:
+    # A generous barrier: twelve end caps booting beside a browser rendering in
+    # software on two busy cores can take more than the default 10 s to answer.
+    with Process([args.tensegrity, "hil", "--duration", "300", "--endcap", args.endcap, "--barrier-timeout", "30",
+                  "--view", "--view-port", str(port), "--view-wait", "120"], hil_log) as hil:
         domain, _ = wait_for("hil --view's page", lambda: hil_domain(hil_log), 60)
         wait_for_server(port, hil)
         driver.get(f"http://127.0.0.1:{port}/")
-        wait_for("12 end caps streaming", lambda: view_state(driver, "live().endcapsSeen") == 12
-                 and view_state(driver, "live().samples") > 200, 120)
+        def streaming():
+            assert hil.proc.poll() is None, f"the HIL run ended early: {open(hil_log).read()[-2000:]}"
+            return view_state(driver, "live().endcapsSeen") == 12 and view_state(driver, "live().samples") > 200
+        wait_for("12 end caps streaming", streaming, 120)
         check_scene(driver, "live")
         check_read_only(port, ["/", "/api/live/events", "/api/live/status", "/api/clock"])
         time.sleep(5)
