@@ -28,6 +28,9 @@ const char* fault_name(std::uint8_t fault) {
     case core::FaultCause::host_lost: return "host_lost";
     case core::FaultCause::emergency_stop: return "emergency_stop";
     case core::FaultCause::bad_input: return "bad_input";
+    case core::FaultCause::node_rebooted: return "node_rebooted";
+    case core::FaultCause::drive_disabled: return "drive_disabled";
+    case core::FaultCause::stale_position: return "stale_position";
   }
   return "?";
 }

@@ -76,6 +76,10 @@ class EndcapDevices {
   // The spool seizes (a jammed gearbox): the cable keeps its length, the drive
   // carries on unaware.
   void seize_spool(std::size_t motor) { seized_.at(motor) = true; }
+  // A power cycle of one device: boot-up message, pre-operational, unpowered
+  // (a drive comes back in switch on disabled, unconfigured); answers to `out`.
+  void reboot_drive(std::size_t motor, std::int64_t now_ns, FrameOut& out) { drives_.at(motor).reboot(now_ns, out); }
+  void reboot_load_cell(std::int64_t now_ns, FrameOut& out) { load_cell_.reboot(now_ns, out); }
   void set_load_cell_stuck(bool stuck) { load_cell_.set_stuck(stuck); }
   void start_load_cell_drift(double n_per_s, std::int64_t now_ns) { load_cell_.start_drift(n_per_s, now_ns); }
 

@@ -255,6 +255,7 @@ HilResult run_hil(const HilOptions& options) {
       s.host_losses = count_lines(log, "host LOST");
       s.host_returns = count_lines(log, "host back");
       s.link_cuts = count_lines(log, "DDS link CUT");
+      s.loop_stalls = count_lines(log, "control loop STALLED");
       result.endcaps.push_back(s);
     }
     phase_offsets(result.endcaps, reports, options.mode, result);
@@ -275,6 +276,7 @@ nlohmann::json to_json(const HilResult& r) {
                        {"host_losses", s.host_losses},
                        {"host_returns", s.host_returns},
                        {"dds_link_cuts", s.link_cuts},
+                       {"loop_stalls", s.loop_stalls},
                        {"exit_status", s.exit_status},
                        {"cpu_s", s.cpu_s},
                        {"restarts", s.restarts},

@@ -75,6 +75,7 @@ struct EndcapSummary {
   int host_losses = 0;
   int host_returns = 0;
   int link_cuts = 0;
+  int loop_stalls = 0;  // the DDS node withheld its heartbeat: the control loop stood still
 };
 
 struct HilResult {

@@ -109,6 +109,12 @@ ProcessLauncher::ProcessLauncher(const LauncherConfig& config, Provisioner& prov
     nlohmann::json drives = nlohmann::json::array();
     for (int m = 0; m < motors; ++m) drives.push_back(kDriveNodeIds[m]);
     const auto& l = config_.limits;
+    nlohmann::json timeouts = {{"drive_heartbeat_s", 0.1}, {"load_cell_heartbeat_s", 0.1}, {"load_cell_sample_s", 0.02}};
+    // Real time on a shared 2-core host: an end cap's loop (or the emulator, whose
+    // catch-up ticks then pass without frames) was seen to stall beyond the default
+    // 50 ms while twelve programs start, and its drives then quick-stop it at boot.
+    // Lockstep keeps the default: its end caps beat in SYNC time, which is device time.
+    if (config_.mode == StepperMode::realtime) timeouts["drive_consumer_heartbeat_s"] = kRealtimeConsumerHeartbeatS;
     const nlohmann::json j = {
         {"format", "tensegrity-endcap/1"},
         // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
@@ -123,7 +129,7 @@ ProcessLauncher::ProcessLauncher(const LauncherConfig& config, Provisioner& prov
         {"initial_rest_length_m", config_.spool.initial_rest_length_m},
         {"storage_dir", (d / "store").string()},
         {"loop", {{"rate_hz", 1000}, {"mode", to_string(config_.mode)}}},
-        {"timeouts", {{"drive_heartbeat_s", 0.1}, {"load_cell_heartbeat_s", 0.1}, {"load_cell_sample_s", 0.02}}},
+        {"timeouts", timeouts},
         {"start_on_boot", false},
         {"stats_log_period_s", 10},
     };
@@ -152,8 +158,9 @@ void ProcessLauncher::start_all() {
 
 void ProcessLauncher::spawn(int e, bool restart) {
   Slot& s = slots_[e];
+  // --hang-loop-signal: the hang_loop fault's test hook (SIGRTMIN), harmless unless sent.
   std::vector<std::string> args{config_.endcap_binary.string(), "--id", std::to_string(e), "--config", s.config.string(),
-                                "--stats-json", s.stats.string()};
+                                "--stats-json", s.stats.string(), "--hang-loop-signal"};
   for (auto& a : provisioner_.endcap_arguments(e, restart)) args.push_back(std::move(a));
   if (const auto extra = config_.extra_args.find(e); extra != config_.extra_args.end()) {
     args.insert(args.end(), extra->second.begin(), extra->second.end());
@@ -304,6 +311,16 @@ std::string ProcessLauncher::set_dds_link(int e, bool up) {
   if (s.pid <= 0) return "not running";
   const int signal = up ? SIGUSR2 : SIGUSR1;
   if (!catches(s.pid, signal)) return "its program does not handle the link signals (yet)";
+  if (::kill(s.pid, signal) != 0) return std::string("kill: ") + std::strerror(errno);
+  return "";
+}
+
+std::string ProcessLauncher::freeze(int e, bool loop_only) {
+  reap(e, false);
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) return "not running";
+  const int signal = loop_only ? SIGRTMIN : SIGSTOP;
+  if (loop_only && !catches(s.pid, signal)) return "its program does not handle the hang signal (yet)";
   if (::kill(s.pid, signal) != 0) return std::string("kill: ") + std::strerror(errno);
   return "";
 }

@@ -70,6 +70,8 @@ class ProcessLauncher final : public EndcapProcesses {
   void restart(int endcap) override;
   // SIGUSR1 (cut) / SIGUSR2 (restore) to a program started with --dds-cut-signals.
   std::string set_dds_link(int endcap, bool up) override;
+  // SIGSTOP, or SIGRTMIN to a program started with --hang-loop-signal (loop_only).
+  std::string freeze(int endcap, bool loop_only) override;
 
   // SIGTERM to every end cap, without waiting (so the emulator can keep serving
   // their buses while they stop); idempotent.
@@ -99,6 +101,10 @@ class ProcessLauncher final : public EndcapProcesses {
   std::vector<double> terminate_cpu_s_;  // CPU seconds when terminate_all() ran
   bool shut_down_ = false;
 };
+
+// The drives' consumer heartbeat time the launcher configures in real time (the
+// end cap's default, 50 ms, in lockstep).
+inline constexpr double kRealtimeConsumerHeartbeatS = 0.2;
 
 // Free UDP ports on 127.0.0.1 for the end caps' buses, from the kLauncherPortSpan
 // ports just below the kernel's ephemeral range (bound together, then released).

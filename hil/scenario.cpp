@@ -14,7 +14,7 @@ namespace tensegrity::hil {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 12> kNames{{
+constexpr std::array<std::pair<FaultKind, const char*>, 16> kNames{{
     {FaultKind::drive_fault, "drive_fault"},
     {FaultKind::drive_silent, "drive_silent"},
     {FaultKind::load_cell_stuck, "load_cell_stuck"},
@@ -27,6 +27,10 @@ constexpr std::array<std::pair<FaultKind, const char*>, 12> kNames{{
     {FaultKind::restore_dds, "restore_dds"},
     {FaultKind::release_spool, "release_spool"},
     {FaultKind::seize_spool, "seize_spool"},
+    {FaultKind::reboot_drive, "reboot_drive"},
+    {FaultKind::reboot_load_cell, "reboot_load_cell"},
+    {FaultKind::hang_loop, "hang_loop"},
+    {FaultKind::stop_endcap, "stop_endcap"},
 }};
 
 FaultKind fault_from_name(const std::string& name, const std::string& where) {
@@ -102,6 +106,7 @@ std::string ScenarioEvent::describe() const {
         << (params.release ? ", released" : ", holding") << ")";
       break;
     case FaultKind::drive_silent:
+    case FaultKind::reboot_drive:
     case FaultKind::release_spool:
     case FaultKind::seize_spool: s << " (motor " << params.motor << ")"; break;
     case FaultKind::load_cell_drift: s << " (" << params.n_per_s << " N/s)"; break;

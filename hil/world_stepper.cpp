@@ -114,7 +114,7 @@ void WorldStepper::lockstep_tick(bool physics) {
     for (const CanFrame& f : out_) hub_.queue(e, f);
     out_.clear();
     ec.devices.clear_rpdo_marks();
-    ec.expected = true;
+    ec.expected = ec.awaited;
   }
   const std::int64_t t_send = monotonic_ns();
   hub_.flush();
@@ -253,6 +253,24 @@ void WorldStepper::apply(const ScenarioEvent& ev) {
       processes_.restart(e);
       ec.state = EndcapState::waiting_process;
       ec.first_answer_pending = true;
+      break;
+    case FaultKind::reboot_drive:
+      for (std::size_t m : motors()) ec.devices.reboot_drive(m, now, out_);
+      for (const CanFrame& f : out_) hub_.queue(e, f);  // the boot-up, ahead of this tick's PDOs
+      out_.clear();
+      break;
+    case FaultKind::reboot_load_cell:
+      ec.devices.reboot_load_cell(now, out_);
+      for (const CanFrame& f : out_) hub_.queue(e, f);
+      out_.clear();
+      break;
+    case FaultKind::hang_loop:
+    case FaultKind::stop_endcap:
+      if (const std::string why = processes_.freeze(e, ev.fault == FaultKind::hang_loop); !why.empty()) {
+        log_.push_back(ev.describe() + ": not done: " + why);
+        return;
+      }
+      ec.awaited = false;
       break;
     case FaultKind::cut_dds:
     case FaultKind::restore_dds: break;  // apply_dds_link

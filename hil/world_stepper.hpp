@@ -63,6 +63,14 @@ class EndcapProcesses {
   // Cuts (up = false) or restores the end cap's DDS link to the host. Returns why
   // it was not done ("" when done): no DDS link in this run, not running, ...
   virtual std::string set_dds_link(int endcap, bool up) = 0;
+  // Fault injection: SIGSTOP the program (a dead end cap, nothing of it runs), or
+  // with loop_only hang its control loop alone (the test hook --hang-loop-signal).
+  // Returns why it was not done ("" when done).
+  virtual std::string freeze(int endcap, bool loop_only) {
+    (void)endcap;
+    (void)loop_only;
+    return "not supported by this launcher";
+  }
 };
 
 enum class StepperMode : std::uint8_t { lockstep, realtime };
@@ -165,6 +173,9 @@ class WorldStepper {
     EndcapState state = EndcapState::waiting_process;
     bool first_answer_pending = true;
     bool expected = false;  // a SYNC went out this tick: wait for its RPDO1s
+    // False once the scenario froze it (stop_endcap, hang_loop): its bus and devices
+    // keep running, the barrier no longer waits for it.
+    bool awaited = true;
   };
 
   std::int64_t now_device_ns() const { return ticks_ * period_ns_; }

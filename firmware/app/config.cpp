@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "firmware/app/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
@@ -44,6 +45,11 @@ class Reader {
     return j_.at(key);
   }
   Reader object(const char* key) const { return Reader(at(key), source_, field(key)); }
+  // An optional object: when absent, an empty one (its fields take their defaults).
+  Reader object_or_empty(const char* key) const {
+    static const json kEmpty = json::object();
+    return has(key) ? object(key) : Reader(kEmpty, source_, field(key));
+  }
 
   double number(const char* key, double fallback, bool required = false) const {
     if (!has(key)) {
@@ -84,6 +90,57 @@ class Reader {
   std::string path_;
 };
 
+// Whole milliseconds, 1..65535: what 0x1016 / 0x1017 can say.
+void check_whole_ms(const Reader& r, const char* key, double s) {
+  const double ms = s * 1e3;
+  if (!(ms >= 1.0 && ms <= 65535.0) || std::fabs(ms - std::round(ms)) > 1e-6) {
+    r.fail(key, "must be a whole number of milliseconds, 0.001..65.535 s (CANopen heartbeat times are in ms)");
+  }
+}
+
+void parse_timeouts(const Reader& top, EndcapAppConfig& c) {
+  const double period_s = 1.0 / c.loop_rate_hz;
+  // Derived defaults: the producer at least one loop period (it beats from the loop).
+  c.endcap_heartbeat_s = std::max(c.endcap_heartbeat_s, std::ceil(period_s * 1e3) * 1e-3);
+  c.drive_consumer_heartbeat_s = 5.0 * c.endcap_heartbeat_s;
+  const Reader t = top.object_or_empty("timeouts");
+  t.only({"drive_heartbeat_s", "load_cell_heartbeat_s", "load_cell_sample_s", "drive_position_s", "endcap_heartbeat_s",
+          "drive_consumer_heartbeat_s"});
+  c.drive_heartbeat_timeout_s = t.positive("drive_heartbeat_s", c.drive_heartbeat_timeout_s);
+  c.load_cell_heartbeat_timeout_s = t.positive("load_cell_heartbeat_s", c.load_cell_heartbeat_timeout_s);
+  c.load_cell_sample_timeout_s = t.positive("load_cell_sample_s", c.load_cell_sample_timeout_s);
+  c.drive_position_timeout_s = t.positive("drive_position_s", c.drive_position_timeout_s);
+  // A freshness timeout shorter than two periods would trip on ordinary jitter.
+  if (c.load_cell_sample_timeout_s < 2.0 * period_s) t.fail("load_cell_sample_s", "must be at least two loop periods");
+  if (c.drive_position_timeout_s < 2.0 * period_s) t.fail("drive_position_s", "must be at least two loop periods");
+  c.endcap_heartbeat_s = t.positive("endcap_heartbeat_s", c.endcap_heartbeat_s);
+  check_whole_ms(t, "endcap_heartbeat_s", c.endcap_heartbeat_s);
+  if (c.endcap_heartbeat_s < period_s - 1e-12) t.fail("endcap_heartbeat_s", "must be at least one loop period");
+  if (!t.has("drive_consumer_heartbeat_s")) c.drive_consumer_heartbeat_s = 5.0 * c.endcap_heartbeat_s;
+  c.drive_consumer_heartbeat_s = t.positive("drive_consumer_heartbeat_s", c.drive_consumer_heartbeat_s);
+  check_whole_ms(t, "drive_consumer_heartbeat_s", c.drive_consumer_heartbeat_s);
+  // One late heartbeat must not stop the motors (CiA 301: consumer above producer).
+  if (c.drive_consumer_heartbeat_s < 2.0 * c.endcap_heartbeat_s - 1e-12) {
+    t.fail("drive_consumer_heartbeat_s", "must be at least twice endcap_heartbeat_s");
+  }
+}
+
+void parse_abort_connection(const Reader& top, EndcapAppConfig& c) {
+  if (!top.has("drive_abort_connection")) return;
+  using A = canopen::AbortConnectionOption;
+  const std::string v = top.string("drive_abort_connection");
+  if (v == "quick_stop") {
+    c.drive_abort_connection = A::quick_stop;
+  } else if (v == "disable_voltage") {
+    c.drive_abort_connection = A::disable_voltage;
+  } else if (v == "fault") {
+    c.drive_abort_connection = A::fault_signal;
+  } else {
+    // "no action" is not offered: a dead end cap must stop its motors.
+    top.fail("drive_abort_connection", "must be \"quick_stop\", \"disable_voltage\" or \"fault\", not \"" + v + "\"");
+  }
+}
+
 }  // namespace
 
 const char* to_string(LoopMode mode) { return mode == LoopMode::lockstep ? "lockstep" : "realtime"; }
@@ -99,7 +156,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   }
   const Reader top(doc, source, "");
   top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
-            "start_on_boot", "stats_log_period_s"});
+            "drive_abort_connection", "start_on_boot", "stats_log_period_s"});
   if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
 
   EndcapAppConfig c;
@@ -112,7 +169,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   if (!parse_can_bus_spec(c.bus, spec, error)) top.fail("bus", error);
 
   const Reader nodes = top.object("nodes");
-  nodes.only({"drives", "load_cell"});
+  nodes.only({"drives", "load_cell", "endcap"});
   const json& drives = nodes.at("drives");
   if (!drives.is_array() || drives.empty() || drives.size() > core::kMaxMotorsPerEndcap) {
     nodes.fail("drives", "must list 1.." + std::to_string(core::kMaxMotorsPerEndcap) + " drive node ids, one per motor");
@@ -130,6 +187,12 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
     c.load_cell_node_id = nodes.node_id(nodes.at("load_cell"), "load_cell");
     if (!seen.insert(c.load_cell_node_id).second) nodes.fail("load_cell", "node id used by a drive too");
     if (c.motor_count > 2) nodes.fail("drives", "the load cell has two channels: at most two motors");
+  }
+  if (nodes.has("endcap")) {
+    c.endcap_node_id = nodes.node_id(nodes.at("endcap"), "endcap");
+    if (!seen.insert(c.endcap_node_id).second) nodes.fail("endcap", "node id used by a drive or the load cell too");
+  } else if (!seen.insert(c.endcap_node_id).second) {
+    nodes.fail("endcap", "the default end-cap node id 127 is taken: give another");
   }
 
   const Reader spool = top.object("spool");
@@ -172,15 +235,8 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
       }
     }
   }
-  if (top.has("timeouts")) {
-    const Reader t = top.object("timeouts");
-    t.only({"drive_heartbeat_s", "load_cell_heartbeat_s", "load_cell_sample_s"});
-    c.drive_heartbeat_timeout_s = t.positive("drive_heartbeat_s", c.drive_heartbeat_timeout_s);
-    c.load_cell_heartbeat_timeout_s = t.positive("load_cell_heartbeat_s", c.load_cell_heartbeat_timeout_s);
-    c.load_cell_sample_timeout_s = t.positive("load_cell_sample_s", c.load_cell_sample_timeout_s);
-    // A sample timeout shorter than two periods would trip on ordinary jitter.
-    if (c.load_cell_sample_timeout_s < 2.0 / c.loop_rate_hz) t.fail("load_cell_sample_s", "must be at least two loop periods");
-  }
+  parse_timeouts(top, c);
+  parse_abort_connection(top, c);
   c.start_on_boot = top.boolean("start_on_boot", false);
   c.stats_log_period_s = top.positive("stats_log_period_s", c.stats_log_period_s);
   return c;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "firmware/core/limits.hpp"
+#include "firmware/drivers/cia402.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 
 namespace tensegrity::fw::app {
@@ -48,6 +49,18 @@ struct EndcapAppConfig {
   // No fresh load-cell sample (new sequence number, channel valid) for this long
   // trips sensor_timeout; a few SYNC periods.
   double load_cell_sample_timeout_s = 0.02;
+  // Supervision (docs/canopen.md "Supervision"). A drive position (TPDO1) older
+  // than this trips stale_position; a few SYNC periods.
+  double drive_position_timeout_s = 0.02;
+  // The end cap's own CANopen node: its heartbeat period (0x1017) and the consumer
+  // time each drive watches it with (0x1016); both whole milliseconds. Defaults:
+  // 10 ms (or one loop period, if longer) and five producer periods, so one late
+  // cycle never trips a drive and a dead end cap is stopped within 50 ms.
+  std::uint8_t endcap_node_id = 127;
+  double endcap_heartbeat_s = 0.01;
+  double drive_consumer_heartbeat_s = 0.05;
+  // 0x6007: what a drive does by itself when the end cap's heartbeat stops.
+  canopen::AbortConnectionOption drive_abort_connection = canopen::AbortConnectionOption::quick_stop;
   bool start_on_boot = false;
   double stats_log_period_s = 10.0;
 

@@ -21,6 +21,17 @@ constexpr double kNsToS = 1e-9;
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
 bool is_sync(const CanFrame& f) { return !f.extended && !f.rtr && f.id == canopen::kSyncCobId && f.dlc <= 1; }
+
+bool quick_stops(FaultCause c) {
+  switch (c) {
+    case FaultCause::drive_fault:
+    case FaultCause::drive_lost:
+    case FaultCause::emergency_stop:
+    case FaultCause::node_rebooted:
+    case FaultCause::drive_disabled: return true;
+    default: return false;
+  }
+}
 }  // namespace
 
 const char* to_string(AppEventKind kind) {
@@ -53,6 +64,11 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   s.master.drive_heartbeat_timeout_ns = to_ns(c.drive_heartbeat_timeout_s);
   s.master.load_cell_heartbeat_timeout_ns = to_ns(c.load_cell_heartbeat_timeout_s);
   s.master.spool = c.spool();
+  s.master.master_node_id = c.endcap_node_id;
+  s.master.producer_heartbeat_period_ns = to_ns(c.endcap_heartbeat_s);
+  s.master.drive_consumer_heartbeat_ms = static_cast<std::uint16_t>(std::llround(c.drive_consumer_heartbeat_s * 1e3));
+  s.master.drive_abort_connection = c.drive_abort_connection;
+  s.safety.drive_position_timeout_ns = to_ns(c.drive_position_timeout_s);
   s.safety.motor_count = c.motor_count;
   s.safety.use_load_cell = c.use_load_cell;
   s.safety.load_cell_sample_timeout_ns = to_ns(c.load_cell_sample_timeout_s);
@@ -109,12 +125,12 @@ void ControlLoop::latch(FaultCause cause, std::int64_t time_ns) {
   if (!first) return;
   pending_start_ = false;
   hold_at_measured();
-  // A drive that faulted or vanished, or an operator's stop: the drives go to
-  // quick stop (decelerate, then hold with power on). Sensor faults and
-  // over-tension keep the drives enabled, holding the measured position.
-  if (cause == FaultCause::drive_fault || cause == FaultCause::drive_lost || cause == FaultCause::emergency_stop) {
-    master_.request_power(PowerRequest::quick_stop);
-  }
+  // A drive that faulted, vanished, rebooted or fell out of operation enabled, or
+  // an operator's stop: the drives go to quick stop (decelerate, then hold with
+  // power on). Sensor faults (a stale position included: the drive is alive, its
+  // heartbeat watched) and over-tension keep the drives enabled, holding the
+  // last measured position.
+  if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
   emit(AppEventKind::fault_latched, time_ns, cause);
 }
 
@@ -245,7 +261,9 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
 
   const bool armed = master_.bring_up_step() == BringUpStep::done;
   FaultCause cause = safety_.check(master_, time_ns, armed);
-  if (cause == FaultCause::drive_fault && time_ns < grace_until_ns_) cause = FaultCause::none;
+  // The fault-reset handshake passes through states other than operation enabled.
+  const bool resetting = cause == FaultCause::drive_fault || cause == FaultCause::drive_disabled;
+  if (resetting && time_ns < grace_until_ns_) cause = FaultCause::none;
   latch(cause, time_ns);
 
   // The newest valid reading per motor; a channel that stays invalid trips

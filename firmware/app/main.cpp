@@ -51,6 +51,13 @@ extern "C" void on_signal(int) { g_stop.store(true); }
 std::atomic<bool> g_link_cut{false};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
 
+// HIL fault injection, tests only (--hang-loop-signal): SIGRTMIN hangs the control
+// loop for good (no cycle, no CAN heartbeat); the process and its DDS node live on.
+std::atomic<bool> g_hang_loop{false};
+extern "C" void on_hang_signal(int) { g_hang_loop.store(true); }
+// The loop's progress, one per pass (a lockstep wait included): the DDS node's watchdog.
+std::atomic<std::uint64_t> g_loop_progress{0};
+
 int g_id = 0;
 template <typename... Args>
 void log_line(const char* format, Args... args) {
@@ -131,6 +138,7 @@ int main(int argc, char** argv) {
   std::string host_loss = "continue";
   int domain = -1;
   bool cut_signals = false;
+  bool hang_signal = false;
   cli.add_option("--id", id, "end cap id, 0..11")->required();
   cli.add_option("--config", config_path, "configuration file (tensegrity-endcap/1 JSON)")->required();
   cli.add_option("--policy", policy_path,
@@ -147,6 +155,8 @@ int main(int argc, char** argv) {
   cli.add_option("--domain", domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
   cli.add_flag("--dds-cut-signals", cut_signals,
                "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
+  cli.add_flag("--hang-loop-signal", hang_signal,
+               "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
   CLI11_PARSE(cli, argc, argv);
   g_id = id;
   // First thing: a SIGUSR1 that arrived before the handler would end the program.
@@ -154,6 +164,7 @@ int main(int argc, char** argv) {
     std::signal(SIGUSR1, on_link_signal);
     std::signal(SIGUSR2, on_link_signal);
   }
+  if (hang_signal) std::signal(SIGRTMIN, on_hang_signal);
 
   app::EndcapAppConfig config;
   core::EndcapTable table;
@@ -214,6 +225,7 @@ int main(int argc, char** argv) {
         node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config.period_ns();
       }
       if (cut_signals) node_config.link_cut = &g_link_cut;
+      node_config.loop_progress = &g_loop_progress;
       node = std::make_unique<comms::EndcapNode>(node_config, clock, storage.get());
       node->start();
       host = node.get();
@@ -240,6 +252,11 @@ int main(int argc, char** argv) {
   std::atomic<bool> loop_stop{false};
   std::thread loop_thread([&] {
     while (!loop_stop.load(std::memory_order_relaxed)) {
+      if (g_hang_loop.load(std::memory_order_relaxed)) {  // the test hook: hung, until asked to exit
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        continue;
+      }
+      g_loop_progress.fetch_add(1, std::memory_order_relaxed);
       if (config.mode == app::LoopMode::realtime) {
         loop->run_realtime_cycle();
       } else {

@@ -24,6 +24,10 @@ FaultCause SafetyMonitor::on_event(const canopen::MasterEvent& e, const canopen:
       return FaultCause::none;
     case MasterEventKind::drive_fault: return FaultCause::drive_fault;
     case MasterEventKind::heartbeat_lost: return drive ? FaultCause::drive_lost : FaultCause::sensor_timeout;
+    // Bring-up resets every node and expects their boot-ups; once it is done a
+    // boot-up means the node lost power or reset itself: pre-operational, unpowered.
+    case MasterEventKind::boot_up:
+      return master.bring_up_step() == canopen::BringUpStep::done ? FaultCause::node_rebooted : FaultCause::none;
     default: return FaultCause::none;
   }
 }
@@ -42,6 +46,7 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   if (armed && !was_armed_) {
     // The sample timeout runs from arming at the earliest.
     for (std::int64_t& t : fresh_ns_) t = t > now_ns ? t : now_ns;
+    armed_ns_ = now_ns;
   }
   was_armed_ = armed;
   if (!armed) return FaultCause::none;
@@ -52,6 +57,13 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   }
   for (std::size_t i = 0; i < master.drive_count(); ++i) {
     if (!master.drive_heartbeat(i).alive) return FaultCause::drive_lost;
+  }
+  const bool enable_wanted = master.power_request() == canopen::PowerRequest::operation_enabled;
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    const canopen::DriveStatus& d = master.drive(i);
+    if (enable_wanted && d.state != Cia402State::operation_enabled) return FaultCause::drive_disabled;
+    const std::int64_t since = d.position_updated_ns > armed_ns_ ? d.position_updated_ns : armed_ns_;
+    if (now_ns - since > config_.drive_position_timeout_ns) return FaultCause::stale_position;
   }
   if (config_.use_load_cell) {
     if (!master.heartbeat(canopen::NodeRole::load_cell).alive) return FaultCause::sensor_timeout;

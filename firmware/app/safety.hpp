@@ -7,6 +7,9 @@
 // silent or booting. The controller latches the first cause; while a condition
 // persists this monitor keeps reporting it, so clearing a fault that is still
 // there trips again on the next cycle. Over-tension is the core's own check.
+// Supervision (docs/canopen.md): a boot-up after bring-up (a node that rebooted
+// comes back pre-operational and unpowered), a drive out of operation enabled
+// that was not asked to leave it, and a drive position older than its timeout.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +23,7 @@ struct SafetyConfig {
   std::uint32_t motor_count = 2;
   bool use_load_cell = true;
   std::int64_t load_cell_sample_timeout_ns = 20'000'000;
+  std::int64_t drive_position_timeout_ns = 20'000'000;
 };
 
 class SafetyMonitor {
@@ -42,6 +46,7 @@ class SafetyMonitor {
   bool sequence_seen_ = false;
   bool was_armed_ = false;
   std::int64_t fresh_ns_[2] = {0, 0};
+  std::int64_t armed_ns_ = 0;  // positions are judged from here at the earliest
 };
 
 }  // namespace tensegrity::fw::app

@@ -94,6 +94,7 @@ void validate(const EndcapNodeConfig& c) {
   positive(c.host_timeout_s, "host_timeout_s", 3600.0);
   positive(c.loop_ack_timeout_s, "loop_ack_timeout_s", 60.0);
   positive(c.command_max_age_s, "command_max_age_s", 3600.0);
+  positive(c.loop_stall_timeout_s, "loop_stall_timeout_s", 60.0);
   if (c.start_grid_ns < 0) throw std::invalid_argument("start_grid_ns = " + std::to_string(c.start_grid_ns) + ": expected >= 0");
 }
 
@@ -179,6 +180,7 @@ void EndcapNode::start() {
   next_telemetry_ns_ = now;
   next_heartbeat_ns_ = now;
   next_sync_ns_ = now;
+  loop_progress_ns_ = now;
   running_.store(true);
   // The remaining readers wake the node thread; created after dds_ is set.
   dds_->policy = dds_->reader(msgs::kPolicyTableTopic, dds::TypeSupport(new m::PolicyTable_PubSubType()),
@@ -550,7 +552,26 @@ void EndcapNode::send_telemetry(std::int64_t now) {
   (void)now;
 }
 
+bool EndcapNode::loop_stalled(std::int64_t now) {
+  if (config_.loop_progress == nullptr) return false;
+  const std::uint64_t progress = config_.loop_progress->load(std::memory_order_relaxed);
+  if (progress != loop_progress_seen_) {
+    loop_progress_seen_ = progress;
+    loop_progress_ns_ = now;
+  }
+  // Armed by the loop's first pass: the program starts its node before its loop.
+  if (progress == 0) return false;
+  const bool stalled = now - loop_progress_ns_ > to_ns(config_.loop_stall_timeout_s);
+  if (stalled != loop_stall_reported_ && config_.log) {
+    std::fprintf(stderr, "endcap %d: control loop %s\n", config_.endcap_id,
+                 stalled ? "STALLED: DDS heartbeat withheld" : "progressing again: DDS heartbeat resumed");
+  }
+  loop_stall_reported_ = stalled;
+  return stalled;
+}
+
 void EndcapNode::send_heartbeat(std::int64_t now) {
+  if (loop_stalled(now)) return;  // a hung loop must look dead to the host
   m::Heartbeat_ hb;
   hb.format_version(msgs::kFormatVersion);
   hb.source(static_cast<std::int16_t>(config_.endcap_id));

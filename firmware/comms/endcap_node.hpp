@@ -67,6 +67,12 @@ struct EndcapNodeConfig {
   // Fault injection (HIL): while *link_cut is true the participant's transport
   // drops every datagram in and out (msgs/link_cut_transport.hpp). Null: never cut.
   const std::atomic<bool>* link_cut = nullptr;
+  // Watchdog: the control loop's progress counter (bumped by the loop thread every
+  // pass, a lockstep wait for SYNC included). When it stands still for
+  // loop_stall_timeout_s the node withholds its heartbeat, so the host sees a hung
+  // loop as a silent end cap. Null: no watchdog.
+  const std::atomic<std::uint64_t>* loop_progress = nullptr;
+  double loop_stall_timeout_s = 0.5;
 };
 
 // Checks rates and timeouts; throws std::invalid_argument naming the field.
@@ -166,6 +172,10 @@ class EndcapNode final : public app::HostLink {
   bool link_was_cut_ = false;
   std::int64_t started_ns_ = 0;  // node clock at start(): older commands are history
   void report_link_cut();
+  bool loop_stalled(std::int64_t now_ns);  // the watchdog; logs changes
+  std::uint64_t loop_progress_seen_ = 0;
+  std::int64_t loop_progress_ns_ = 0;  // node clock when the counter last moved
+  bool loop_stall_reported_ = false;
 
   mutable std::mutex mutex_;  // guards active_, sync_ (listener thread vs node thread)
   ActivePolicy active_;

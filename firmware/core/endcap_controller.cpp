@@ -13,6 +13,9 @@ const char* describe(FaultCause cause) noexcept {
     case FaultCause::host_lost: return "host link lost";
     case FaultCause::emergency_stop: return "emergency stop";
     case FaultCause::bad_input: return "control step called with too few motors";
+    case FaultCause::node_rebooted: return "CANopen node rebooted";
+    case FaultCause::drive_disabled: return "motor drive left operation enabled";
+    case FaultCause::stale_position: return "motor drive position stale";
   }
   return "unknown fault";
 }

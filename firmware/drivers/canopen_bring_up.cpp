@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // CanopenMaster's start-up sequence, one step per poll() so the control loop
 // keeps its period while the nodes come up.
+#include <array>
 #include <cstdio>
 
 #include "firmware/drivers/canopen_master.hpp"
@@ -15,6 +16,12 @@ void CanopenMaster::start_bring_up(std::int64_t now_ns) {
   // also when it was left operational by an earlier run of the firmware.
   for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::reset_communication, config_.drive_node(i));
   if (config_.use_load_cell) send_nmt(NmtCommand::reset_communication, config_.load_cell_node_id);
+  // The end cap's heartbeat starts now: the drives are told to watch it below, and
+  // monitoring on their side starts with the first one they hear after that.
+  if (!producing_heartbeat_) {
+    producing_heartbeat_ = true;
+    next_heartbeat_ns_ = now_ns;
+  }
   enter_step(BringUpStep::wait_boot, now_ns);
 }
 
@@ -30,7 +37,9 @@ void CanopenMaster::fail_bring_up(const char* what, std::int64_t now_ns, std::ui
   // With several drives the text names the one that failed (drive node id).
   char where[48];
   const BringUpStep step = bring_up_.step;
-  const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode || step == BringUpStep::enable;
+  const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode ||
+                         step == BringUpStep::set_heartbeat_consumer || step == BringUpStep::set_abort_connection ||
+                         step == BringUpStep::enable;
   if (drive_count_ > 1 && per_drive) {
     std::snprintf(where, sizeof where, "%s (drive %u)", to_string(bring_up_.step),
                   static_cast<unsigned>(config_.drive_node(bring_up_.drive_index)));
@@ -47,6 +56,76 @@ void CanopenMaster::fail_bring_up(const char* what, std::int64_t now_ns, std::ui
   emit(MasterEventKind::bring_up_failed, config_.drive_node_id, now_ns);
 }
 
+namespace {
+// The per-drive SDO steps of bring-up, in order: what each writes or reads.
+struct SdoStepSpec {
+  BringUpStep step;
+  bool upload;
+  SdoAddress address;
+  std::uint8_t size_bytes;
+  const char* what;  // for the failure text
+};
+constexpr std::array<SdoStepSpec, 4> kSdoSteps{{
+    {BringUpStep::set_mode, false, {kOdModesOfOperation, 0}, 1, "writing 0x6060"},
+    {BringUpStep::check_mode, true, {kOdModesOfOperationDisplay, 0}, 0, "reading 0x6061"},
+    {BringUpStep::set_heartbeat_consumer, false, {kOdConsumerHeartbeatTime, 1}, 4, "writing 0x1016 sub 1"},
+    {BringUpStep::set_abort_connection, false, {kOdAbortConnectionOption, 0}, 2, "writing 0x6007"},
+}};
+}  // namespace
+
+// One SDO step for drive bring_up_.drive_index: starts the transfer once, then
+// waits for its outcome. True when it finished: `next` is the step to go on with
+// (failed: fail_bring_up was called).
+bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
+  BringUp& b = bring_up_;
+  const SdoStepSpec* spec = nullptr;
+  for (const SdoStepSpec& s : kSdoSteps) {
+    if (s.step == b.step) spec = &s;
+  }
+  if (spec == nullptr) return false;
+  // Each drive watches the end cap's heartbeat and stops its motor by itself when
+  // the end cap falls silent (dead computer, hung loop).
+  const bool supervised = config_.drive_consumer_heartbeat_ms > 0 && config_.producer_heartbeat_period_ns > 0;
+  std::uint32_t value = 0;
+  switch (b.step) {
+    case BringUpStep::set_mode: value = kModeCyclicSynchronousPosition; break;
+    case BringUpStep::set_heartbeat_consumer:
+      value = consumer_heartbeat_entry(config_.master_node_id, config_.drive_consumer_heartbeat_ms);
+      break;
+    case BringUpStep::set_abort_connection:
+      value = static_cast<std::uint16_t>(config_.drive_abort_connection);
+      break;
+    default: break;
+  }
+  SdoClient& sdo = drives_[b.drive_index].sdo;
+  if (!b.request_sent) {
+    b.request_sent =
+        sdo_start(NodeRef{NodeRole::drive, b.drive_index}, spec->upload, spec->address, value, spec->size_bytes, now_ns);
+    return false;
+  }
+  if (sdo.transfer().status == SdoStatus::pending) return false;
+  const SdoTransfer done = sdo.transfer();
+  sdo.acknowledge();
+  next = BringUpStep::failed;
+  if (done.status != SdoStatus::done) {
+    fail_bring_up(spec->what, now_ns, done.abort_code);
+    return true;
+  }
+  switch (b.step) {
+    case BringUpStep::set_mode: next = BringUpStep::check_mode; break;
+    case BringUpStep::check_mode:
+      if (static_cast<std::int8_t>(done.value & 0xFFU) != kModeCyclicSynchronousPosition) {
+        fail_bring_up("drive does not report mode 8 (cyclic synchronous position)", now_ns);
+        return true;
+      }
+      next = supervised ? BringUpStep::set_heartbeat_consumer : BringUpStep::start_nodes;
+      break;
+    case BringUpStep::set_heartbeat_consumer: next = BringUpStep::set_abort_connection; break;
+    default: next = BringUpStep::start_nodes; break;
+  }
+  return true;
+}
+
 void CanopenMaster::step_bring_up(std::int64_t now_ns) {
   BringUp& b = bring_up_;
   if (b.step == BringUpStep::idle || b.step == BringUpStep::done || b.step == BringUpStep::failed) return;
@@ -56,17 +135,6 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
   };
   const auto operational = [](const HeartbeatMonitor& hb) {
     return hb.status().alive && hb.status().state == NmtState::operational;
-  };
-  // An SDO step: start the transfer once, then wait for its outcome.
-  // Drive b.drive_index's SDO client: set_mode and check_mode visit the drives in turn.
-  SdoClient& sdo = drives_[b.drive_index].sdo;
-  const auto sdo_step = [&](bool upload, std::uint16_t index, std::uint32_t value) -> const SdoTransfer* {
-    if (!b.request_sent) {
-      b.request_sent = sdo_start(NodeRef{NodeRole::drive, b.drive_index}, upload, {index, 0}, value, 1, now_ns);
-      return nullptr;
-    }
-    const SdoTransfer& t = sdo.transfer();
-    return t.status == SdoStatus::pending ? nullptr : &t;
   };
   // Next drive within the same step, or the next step after the last drive.
   const auto next_drive_or = [&](BringUpStep next) {
@@ -94,26 +162,14 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
       }
       break;
     case BringUpStep::set_mode:
-      if (const SdoTransfer* t = sdo_step(false, kOdModesOfOperation, kModeCyclicSynchronousPosition)) {
-        const SdoTransfer done = *t;
-        sdo.acknowledge();
-        if (done.status != SdoStatus::done) return fail_bring_up("writing 0x6060", now_ns, done.abort_code);
-        next_drive_or(BringUpStep::check_mode);
-        return;
-      }
-      break;
     case BringUpStep::check_mode:
-      if (const SdoTransfer* t = sdo_step(true, kOdModesOfOperationDisplay, 0)) {
-        const SdoTransfer done = *t;
-        sdo.acknowledge();
-        if (done.status != SdoStatus::done) return fail_bring_up("reading 0x6061", now_ns, done.abort_code);
-        if (static_cast<std::int8_t>(done.value & 0xFFU) != kModeCyclicSynchronousPosition) {
-          return fail_bring_up("drive does not report mode 8 (cyclic synchronous position)", now_ns);
-        }
-        next_drive_or(BringUpStep::start_nodes);
-        return;
-      }
-      break;
+    case BringUpStep::set_heartbeat_consumer:
+    case BringUpStep::set_abort_connection: {
+      BringUpStep next = BringUpStep::idle;
+      if (!step_drive_sdo(now_ns, next)) break;  // still waiting for the answer
+      if (next != BringUpStep::failed) next_drive_or(next);
+      return;
+    }
     case BringUpStep::start_nodes:
       if (!b.request_sent) {
         for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::start, config_.drive_node(i));

@@ -31,6 +31,8 @@ const char* to_string(BringUpStep step) {
     case BringUpStep::wait_boot: return "waiting for boot-up";
     case BringUpStep::set_mode: return "setting mode CSP";
     case BringUpStep::check_mode: return "checking mode";
+    case BringUpStep::set_heartbeat_consumer: return "configuring heartbeat consumer";
+    case BringUpStep::set_abort_connection: return "setting abort connection option";
     case BringUpStep::start_nodes: return "starting nodes";
     case BringUpStep::enable: return "enabling drive";
     case BringUpStep::done: return "done";
@@ -257,7 +259,18 @@ void CanopenMaster::poll(std::int64_t now_ns) {
   };
   for (std::size_t i = 0; i < drive_count_; ++i) poll_sdo(NodeRef{NodeRole::drive, i});
   poll_sdo(NodeRef{NodeRole::load_cell, 0});
+  produce_heartbeat(now_ns);
   step_bring_up(now_ns);
+}
+
+// The end cap's heartbeat comes from the control loop's own cycle (poll), so a
+// loop that hangs falls silent on the bus and its drives take their 0x6007 action.
+void CanopenMaster::produce_heartbeat(std::int64_t now_ns) {
+  if (!producing_heartbeat_ || config_.producer_heartbeat_period_ns <= 0 || now_ns < next_heartbeat_ns_) return;
+  if (bus_.send(encode_heartbeat(config_.master_node_id, NmtState::operational)) == CanResult::ok) ++heartbeats_sent_;
+  next_heartbeat_ns_ += config_.producer_heartbeat_period_ns;
+  // After a stall, one heartbeat now and the period from here, not a burst.
+  if (next_heartbeat_ns_ <= now_ns) next_heartbeat_ns_ = now_ns + config_.producer_heartbeat_period_ns;
 }
 
 CanResult CanopenMaster::write_target(std::size_t drive_index, double rest_length_m) {

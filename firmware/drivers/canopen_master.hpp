@@ -47,6 +47,14 @@ struct CanopenMasterConfig {
   std::int64_t sdo_timeout_ns = 50'000'000;
   std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
   std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
+  // Supervision the other way (docs/canopen.md "Supervision"): the end cap's own
+  // node id and heartbeat (its 0x1017; 0: none), which every drive is told to
+  // watch in bring-up (0x1016 sub 1, consumer time; 0: not configured) with the
+  // abort-connection option (0x6007) it takes by itself when the end cap falls silent.
+  std::uint8_t master_node_id = 127;
+  std::int64_t producer_heartbeat_period_ns = 10'000'000;
+  std::uint16_t drive_consumer_heartbeat_ms = 50;
+  AbortConnectionOption drive_abort_connection = AbortConnectionOption::quick_stop;
   SpoolGeometry spool;  // the same spool on every drive
 
   std::uint8_t drive_node(std::size_t index) const {
@@ -116,6 +124,8 @@ enum class BringUpStep : std::uint8_t {
   wait_boot,     // after NMT reset communication: wait for each node's boot-up/heartbeat
   set_mode,      // SDO 0x6060 = 8 (cyclic synchronous position)
   check_mode,    // SDO 0x6061 must read 8
+  set_heartbeat_consumer,  // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
+  set_abort_connection,    // SDO 0x6007 = the abort-connection option (with the consumer only)
   start_nodes,   // NMT start; wait for heartbeats saying operational
   enable,        // CiA 402 power-up to operation enabled (needs write_target each cycle)
   done,
@@ -174,6 +184,8 @@ class CanopenMaster {
   }
   const HeartbeatStatus& drive_heartbeat(std::size_t index) const { return drives_[index].hb.status(); }
   const SyncStatus& sync() const { return sync_; }
+  // The end cap's own heartbeats sent (producer, from start_bring_up on).
+  std::uint64_t heartbeats_sent() const { return heartbeats_sent_; }
   bool pop_event(MasterEvent& event) { return events_.pop(event); }
   std::uint64_t events_lost() const { return events_.overflows(); }
   const RxDropCounters& rx_drops() const { return drops_; }
@@ -228,7 +240,9 @@ class CanopenMaster {
   void on_sdo(const CanFrame& frame, NodeRef node, std::int64_t now_ns);
   void on_sync(const CanFrame& frame, std::int64_t now_ns);
 
+  void produce_heartbeat(std::int64_t now_ns);
   void step_bring_up(std::int64_t now_ns);
+  bool step_drive_sdo(std::int64_t now_ns, BringUpStep& next);
   void enter_step(BringUpStep step, std::int64_t now_ns);
   void fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t detail = 0);
 
@@ -241,6 +255,9 @@ class CanopenMaster {
   LoadCellStatus load_cell_;
   SyncStatus sync_;
   std::uint8_t next_sync_counter_ = 1;
+  bool producing_heartbeat_ = false;
+  std::int64_t next_heartbeat_ns_ = 0;
+  std::uint64_t heartbeats_sent_ = 0;
   BringUp bring_up_;
   EventQueue<MasterEvent, kEventCapacity> events_;
   RxDropCounters drops_;

@@ -17,6 +17,15 @@ inline constexpr std::uint16_t kOdPositionActual = 0x6064;
 inline constexpr std::uint16_t kOdVelocityActual = 0x606C;
 inline constexpr std::uint16_t kOdTargetPosition = 0x607A;
 inline constexpr std::int8_t kModeCyclicSynchronousPosition = 8;
+// Abort connection option code (INTEGER16): what the drive does by itself when it
+// loses its master (a heartbeat it consumes through 0x1016 times out).
+inline constexpr std::uint16_t kOdAbortConnectionOption = 0x6007;
+enum class AbortConnectionOption : std::int16_t {
+  no_action = 0,
+  fault_signal = 1,      // the drive goes to fault
+  disable_voltage = 2,   // power stage off: the motor coasts (or its brake holds)
+  quick_stop = 3,        // decelerate on the quick-stop ramp, then hold
+};
 
 enum class Cia402State : std::uint8_t {
   not_ready_to_switch_on,

@@ -9,6 +9,15 @@
 
 namespace tensegrity::fw::canopen {
 
+// Heartbeat objects (CiA 301 7.5.2.29-30). 0x1016 sub n (UNSIGNED32): bits 23-16
+// the producer's node id, bits 15-0 the consumer time in ms (0: unused).
+// 0x1017 (UNSIGNED16): this node's producer period in ms.
+inline constexpr std::uint16_t kOdConsumerHeartbeatTime = 0x1016;
+inline constexpr std::uint16_t kOdProducerHeartbeatTime = 0x1017;
+inline constexpr std::uint32_t consumer_heartbeat_entry(std::uint8_t producer_node_id, std::uint16_t time_ms) {
+  return (static_cast<std::uint32_t>(producer_node_id) << 16) | time_ms;
+}
+
 enum class NmtCommand : std::uint8_t {
   start = 0x01,
   stop = 0x02,

@@ -25,10 +25,30 @@ std::uint16_t SimCia402Drive::statusword() const {
 }
 
 void SimCia402Drive::on_reset_node() {
+  if (state_ == Cia402State::operation_enabled) left_enabled_ns_ = now_ns_;
   state_ = Cia402State::switch_on_disabled;
   mode_ = 0;
   last_controlword_ = 0;
   enable_requested_ = false;
+  abort_option_ = AbortConnectionOption::fault_signal;
+}
+
+// CiA 402 abort connection: the end cap's heartbeat (0x1016) timed out.
+void SimCia402Drive::on_heartbeat_lost(std::int64_t now_ns, FrameOut& out) {
+  now_ns_ = now_ns;
+  const bool was_enabled = state_ == Cia402State::operation_enabled;
+  switch (abort_option_) {
+    case AbortConnectionOption::no_action: return;
+    case AbortConnectionOption::fault_signal:
+      inject_fault(0x8130, now_ns, out);  // EMCY 0x8130: life guard / heartbeat error
+      break;
+    case AbortConnectionOption::disable_voltage: on_connection_lost(); break;
+    case AbortConnectionOption::quick_stop:
+      if (state_ == Cia402State::operation_enabled) state_ = Cia402State::quick_stop_active;
+      enable_requested_ = false;
+      break;
+  }
+  if (was_enabled && state_ != Cia402State::operation_enabled) left_enabled_ns_ = now_ns;
 }
 
 void SimCia402Drive::inject_fault(std::uint16_t error_code, std::int64_t, FrameOut& out) {
@@ -43,6 +63,7 @@ void SimCia402Drive::inject_fault(std::uint16_t error_code, std::int64_t, FrameO
 }
 
 void SimCia402Drive::tick(std::int64_t now_ns, FrameOut& out) {
+  now_ns_ = now_ns;
   if (state_ == Cia402State::fault_reaction_active) state_ = Cia402State::fault;
   SimNode::tick(now_ns, out);
 }
@@ -64,6 +85,9 @@ bool SimCia402Drive::at_enable_gate() const {
 }
 
 void SimCia402Drive::release_enable_gate() {
+  // The gate stopped this end cap's time (no SYNC, no cycle, no heartbeat from it):
+  // that pause is the emulator's, not a silent end cap.
+  restart_consumer_timer();
   if (at_enable_gate()) state_ = Cia402State::operation_enabled;
   enable_requested_ = false;
 }
@@ -80,6 +104,12 @@ bool SimCia402Drive::follows_target() const {
 }
 
 void SimCia402Drive::apply_controlword(std::uint16_t cw) {
+  const bool was_enabled = state_ == Cia402State::operation_enabled;
+  apply_controlword_to_state(cw);
+  if (was_enabled && state_ != Cia402State::operation_enabled) left_enabled_ns_ = now_ns_;
+}
+
+void SimCia402Drive::apply_controlword_to_state(std::uint16_t cw) {
   if (log_controlwords) controlwords.push_back(cw);
   Cia402Command c{};
   const bool known = decode_controlword(cw, c);
@@ -131,7 +161,8 @@ void SimCia402Drive::apply_controlword(std::uint16_t cw) {
   }
 }
 
-void SimCia402Drive::on_pdo_or_sync(const CanFrame& frame, std::int64_t, FrameOut& out) {
+void SimCia402Drive::on_pdo_or_sync(const CanFrame& frame, std::int64_t now_ns, FrameOut& out) {
+  now_ns_ = now_ns;
   DriveRpdo1 rpdo;
   if (frame.id == cob_id(Function::rpdo1, node_id()) && decode_drive_rpdo1(frame, rpdo)) {
     ++rpdos_received_;
@@ -155,6 +186,12 @@ void SimCia402Drive::on_pdo_or_sync(const CanFrame& frame, std::int64_t, FrameOu
 }
 
 std::uint32_t SimCia402Drive::od_read(SdoAddress a, std::uint32_t& value, std::uint8_t& size) {
+  if (a.index == kOdAbortConnectionOption) {
+    if (a.subindex != 0) return sdo_abort::kNoSubindex;
+    value = static_cast<std::uint16_t>(abort_option_);
+    size = 2;
+    return 0;
+  }
   const bool maybe_known = a.index == 0x1000 || (a.index >= kOdControlword && a.index <= kOdTargetPosition);
   if (!maybe_known) return sdo_abort::kNoObject;
   if (a.subindex != 0) return sdo_abort::kNoSubindex;
@@ -179,6 +216,14 @@ std::uint32_t SimCia402Drive::od_write(SdoAddress a, std::uint32_t value, std::u
       const auto mode = static_cast<std::int8_t>(value);
       if (mode != kModeCyclicSynchronousPosition && mode != 1) return sdo_abort::kValueRange;
       mode_ = mode;
+      return 0;
+    }
+    case kOdAbortConnectionOption: {
+      if (a.subindex != 0) return sdo_abort::kNoSubindex;
+      if (size != 2) return sdo_abort::kLengthMismatch;
+      const auto option = static_cast<std::int16_t>(value & 0xFFFFU);
+      if (option < 0 || option > 3) return sdo_abort::kValueRange;  // manufacturer codes: none here
+      abort_option_ = static_cast<AbortConnectionOption>(option);
       return 0;
     }
     case kOdControlword:

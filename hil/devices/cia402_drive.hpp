@@ -45,8 +45,13 @@ class SimCia402Drive final : public SimNode {
   void release_enable_gate();
   // The master stopped talking (its process died): CiA 402 "abort connection"
   // reaction, option disable voltage. The drive stops following targets and
-  // must be brought up again.
+  // must be brought up again. (The HIL's kill_endcap says so directly; a drive
+  // whose 0x1016 watches the end cap finds out by itself: on_heartbeat_lost.)
   void on_connection_lost();
+  // 0x6007 as configured (power-on value: fault signal).
+  canopen::AbortConnectionOption abort_connection_option() const { return abort_option_; }
+  // Device time at which the drive last left operation enabled (-1: never).
+  std::int64_t left_enabled_ns() const { return left_enabled_ns_; }
   // Operation enabled in CSP and answering: the motor follows target_counts().
   bool follows_target() const;
 
@@ -66,10 +71,12 @@ class SimCia402Drive final : public SimNode {
   std::uint32_t od_read(canopen::SdoAddress address, std::uint32_t& value, std::uint8_t& size) override;
   std::uint32_t od_write(canopen::SdoAddress address, std::uint32_t value, std::uint8_t size) override;
   void on_reset_node() override;
+  void on_heartbeat_lost(std::int64_t now_ns, FrameOut& out) override;
   void on_pdo_or_sync(const CanFrame& frame, std::int64_t now_ns, FrameOut& out) override;
 
  private:
   void apply_controlword(std::uint16_t controlword);
+  void apply_controlword_to_state(std::uint16_t controlword);
 
   canopen::Cia402State state_ = canopen::Cia402State::switch_on_disabled;
   std::int8_t mode_ = 0;
@@ -82,6 +89,9 @@ class SimCia402Drive final : public SimNode {
   bool enable_requested_ = false;
   std::uint64_t rpdos_received_ = 0;
   std::uint64_t emcy_sent_ = 0;
+  canopen::AbortConnectionOption abort_option_ = canopen::AbortConnectionOption::fault_signal;
+  std::int64_t left_enabled_ns_ = -1;
+  std::int64_t now_ns_ = 0;  // of the frame or tick being handled
 };
 
 }  // namespace tensegrity::hil

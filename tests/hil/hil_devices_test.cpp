@@ -170,5 +170,81 @@ TEST(HilEndcapDevices, FollowHoldRelease) {
   EXPECT_DOUBLE_EQ(pref[2], 0.93) << "faulted, brake on: holds where it is";
 }
 
+// The drive watches the end cap's heartbeat (0x1016, written by SDO as the end
+// cap's bring-up does) and takes its 0x6007 action when it stops; the HIL's start
+// gate, which stops the end cap's time, is not mistaken for silence.
+TEST(HilDrive, HonoursConsumerHeartbeatAndAbortConnection) {
+  SimCia402Drive d(1);
+  FrameOut out;
+  operational(d, out);
+  set_csp(d, out);
+  d.on_frame(encode_sdo(1, {SdoKind::download_request, {kOdConsumerHeartbeatTime, 1}, (127U << 16) | 30U, 4}), 0, out);
+  d.on_frame(encode_sdo(1, {SdoKind::download_request, {kOdAbortConnectionOption, 0}, 3, 2}), 0, out);
+  EXPECT_EQ(d.consumer_time_ms(), 30);
+  EXPECT_EQ(d.abort_connection_option(), AbortConnectionOption::quick_stop);
+  power_up(d, out);
+  ASSERT_EQ(d.state(), Cia402State::operation_enabled);
+  for (std::int64_t t = 0; t <= 100'000'000; t += 1'000'000) d.tick(t, out);
+  EXPECT_EQ(d.heartbeat_losses(), 0u) << "monitoring starts with the first heartbeat";
+  d.on_frame(encode_heartbeat(127, NmtState::operational), 100'000'000, out);
+  d.on_frame(encode_heartbeat(126, NmtState::operational), 120'000'000, out);  // another node's: ignored
+  for (std::int64_t t = 100'000'000; t <= 130'000'000; t += 1'000'000) d.tick(t, out);
+  EXPECT_EQ(d.state(), Cia402State::operation_enabled) << "30 ms is not yet more than 30 ms";
+  d.tick(131'000'000, out);
+  EXPECT_EQ(d.heartbeat_losses(), 1u);
+  EXPECT_EQ(d.heartbeat_lost_ns(), 131'000'000);
+  EXPECT_EQ(d.state(), Cia402State::quick_stop_active);
+  EXPECT_EQ(d.left_enabled_ns(), 131'000'000);
+  // Refused values are SDO aborts.
+  out.clear();
+  d.on_frame(encode_sdo(1, {SdoKind::download_request, {kOdAbortConnectionOption, 0}, 9, 2}), 0, out);
+  SdoMessage m;
+  ASSERT_TRUE(decode_sdo(out.back(), true, m));
+  EXPECT_EQ(m.kind, SdoKind::abort);
+}
+
+TEST(HilDrive, StartGatePauseIsNotSilence) {
+  SimCia402Drive d(1);
+  d.hold_enable = true;
+  FrameOut out;
+  operational(d, out);
+  set_csp(d, out);
+  d.on_frame(encode_sdo(1, {SdoKind::download_request, {kOdConsumerHeartbeatTime, 1}, (127U << 16) | 30U, 4}), 0, out);
+  d.on_frame(encode_sdo(1, {SdoKind::download_request, {kOdAbortConnectionOption, 0}, 3, 2}), 0, out);
+  d.on_frame(encode_heartbeat(127, NmtState::operational), 0, out);
+  power_up(d, out);
+  ASSERT_TRUE(d.at_enable_gate());
+  d.release_enable_gate();  // four seconds of device time later, no tick in between
+  d.tick(4'000'000'000, out);
+  EXPECT_EQ(d.heartbeat_losses(), 0u);
+  EXPECT_EQ(d.state(), Cia402State::operation_enabled);
+  d.tick(4'031'000'000, out);
+  EXPECT_EQ(d.state(), Cia402State::quick_stop_active) << "and monitoring goes on from there";
+}
+
+TEST(HilEndcapDevices, RebootedDriveComesBackPreOperationalAndUnpowered) {
+  const fw::SpoolGeometry spool{0.01, 4096.0 * 109.0, 0.95};
+  EndcapDevices dev(0, {0, 2}, spool, 1.1, true);
+  FrameOut out;
+  dev.power_on(0, out);
+  dev.on_frame(encode_nmt(NmtCommand::start, 0), 0, out);
+  out.clear();
+  dev.reboot_drive(1, 5'000'000, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id, 0x700u + 3u);
+  EXPECT_EQ(out[0].data[0], 0) << "boot-up";
+  EXPECT_EQ(dev.drive(1).nmt_state(), NmtState::pre_operational);
+  EXPECT_EQ(dev.drive(1).state(), Cia402State::switch_on_disabled);
+  EXPECT_EQ(dev.drive(1).reboots(), 1u);
+  EXPECT_EQ(dev.drive(0).nmt_state(), NmtState::operational);
+  out.clear();
+  dev.emit_sensors(out);
+  for (const CanFrame& f : out) EXPECT_NE(f.id, 0x180u + 3u) << "no TPDO from a pre-operational drive";
+  out.clear();
+  dev.reboot_load_cell(6'000'000, out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].id, 0x700u + kLoadCellNodeId);
+}
+
 }  // namespace
 }  // namespace tensegrity::hil

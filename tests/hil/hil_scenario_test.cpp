@@ -54,6 +54,26 @@ TEST(HilScenario, FaultOption) {
   EXPECT_THROW(parse_fault_option("3:kill_endcap@5x", 12), HilError);
 }
 
+TEST(HilScenario, SupervisionFaults) {
+  const Scenario s = parse_scenario(R"([
+      {"time_s": 1.0, "endcap": 3, "fault": "reboot_drive", "params": {"motor": 1}},
+      {"time_s": 2.0, "endcap": 4, "fault": "reboot_load_cell"},
+      {"time_s": 3.0, "endcap": 5, "fault": "hang_loop"},
+      {"time_s": 4.0, "endcap": 6, "fault": "stop_endcap"}])",
+                                    12);
+  ASSERT_EQ(s.events.size(), 4u);
+  EXPECT_EQ(s.events[0].fault, FaultKind::reboot_drive);
+  EXPECT_EQ(s.events[0].params.motor, 1);
+  EXPECT_NE(s.events[0].describe().find("end cap 3: reboot_drive (motor 1)"), std::string::npos);
+  EXPECT_EQ(s.events[1].fault, FaultKind::reboot_load_cell);
+  EXPECT_EQ(s.events[2].fault, FaultKind::hang_loop);
+  EXPECT_EQ(s.events[3].fault, FaultKind::stop_endcap);
+  EXPECT_EQ(parse_fault_option("7:hang_loop@2", 12).fault, FaultKind::hang_loop);
+  EXPECT_EQ(parse_fault_option("7:stop_endcap@2", 12).fault, FaultKind::stop_endcap);
+  EXPECT_THROW(parse_fault_option("all:stop_endcap@2", 12), HilError);
+  EXPECT_THROW(parse_scenario(R"([{"time_s": 1, "fault": "hang_loop"}])", 12), HilError) << "needs an end cap";
+}
+
 TEST(HilScenario, DisabledCableFaultsItsOwnersDriveAndReleasesIt) {
   const sim::Robot robot = sim::load_robot(sim::default_robot_path());
   // Cable 3 (nodes 0-10) is owned by end cap 10, whose cables are 3 and 16.

@@ -116,6 +116,57 @@ std::string policy_json(double value_for_cable_5) {
       .dump();
 }
 
+TEST(EndcapConfig, SupervisionDefaultsAreDerivedFromTheLoop) {
+  EndcapAppConfig c = parse_config(example().dump(), 3);  // 500 Hz
+  EXPECT_EQ(c.endcap_node_id, 127);
+  EXPECT_DOUBLE_EQ(c.endcap_heartbeat_s, 0.01);
+  EXPECT_DOUBLE_EQ(c.drive_consumer_heartbeat_s, 0.05) << "five producer periods";
+  EXPECT_DOUBLE_EQ(c.drive_position_timeout_s, 0.02);
+  EXPECT_EQ(c.drive_abort_connection, canopen::AbortConnectionOption::quick_stop);
+  json slow = example();
+  slow["loop"]["rate_hz"] = 40;  // 25 ms period: the producer beats once a cycle at most
+  slow["timeouts"] = {{"load_cell_sample_s", 0.1}, {"drive_position_s", 0.1}};
+  c = parse_config(slow.dump(), 3);
+  EXPECT_DOUBLE_EQ(c.endcap_heartbeat_s, 0.025);
+  EXPECT_DOUBLE_EQ(c.drive_consumer_heartbeat_s, 0.125);
+  json given = example();
+  given["nodes"]["endcap"] = 100;
+  given["timeouts"] = {{"endcap_heartbeat_s", 0.02}, {"drive_position_s", 0.05}};
+  given["drive_abort_connection"] = "disable_voltage";
+  c = parse_config(given.dump(), 3);
+  EXPECT_EQ(c.endcap_node_id, 100);
+  EXPECT_DOUBLE_EQ(c.drive_consumer_heartbeat_s, 0.1) << "derived from the given producer period";
+  EXPECT_DOUBLE_EQ(c.drive_position_timeout_s, 0.05);
+  EXPECT_EQ(c.drive_abort_connection, canopen::AbortConnectionOption::disable_voltage);
+}
+
+TEST(EndcapConfig, SupervisionErrorsNameTheField) {
+  const auto with = [](const char* key, const json& value) {
+    json j = example();
+    j["timeouts"][key] = value;
+    return j;
+  };
+  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.0105)), HasSubstr("timeouts.endcap_heartbeat_s: must be a whole number of milliseconds"));
+  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.001)), HasSubstr("timeouts.endcap_heartbeat_s: must be at least one loop period"));
+  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 70.0)), HasSubstr("timeouts.endcap_heartbeat_s"));
+  EXPECT_THAT(error_of(with("drive_consumer_heartbeat_s", 0.015)),
+              HasSubstr("timeouts.drive_consumer_heartbeat_s: must be at least twice endcap_heartbeat_s"));
+  EXPECT_THAT(error_of(with("drive_position_s", 0.003)), HasSubstr("timeouts.drive_position_s: must be at least two loop periods"));
+  EXPECT_THAT(error_of(with("drive_position_s", -1)), HasSubstr("timeouts.drive_position_s: must be > 0"));
+  json j = example();
+  j["drive_abort_connection"] = "none";
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: drive_abort_connection: must be \"quick_stop\""));
+  j = example();
+  j["nodes"]["endcap"] = 3;
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.endcap: node id used by a drive or the load cell too"));
+  j = example();
+  j["nodes"]["endcap"] = 128;
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.endcap: must be a CANopen node id 1..127"));
+  j = example();
+  j["nodes"]["drives"] = {1, 127};
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.endcap: the default end-cap node id 127 is taken"));
+}
+
 TEST(PolicyFile, TakesThisEndcapsCablesInIndexOrder) {
   const core::EndcapTable t = endcap_table_from_policy(policy_json(0.8), 2, 2, core::MotorLimits{});
   EXPECT_EQ(t.motor_count, 2U);

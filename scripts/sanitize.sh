@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# The sanitizer runs of CI (issue 15), each a subset chosen to fit CI's time:
+#   asan  AddressSanitizer + UndefinedBehaviorSanitizer on every unit-test
+#         executable and the end cap's end-to-end tests (12 real `endcap` processes)
+#   tsan  ThreadSanitizer on the threads that share memory: the control loop's
+#         mailbox, the end cap's DDS node (end caps in comms_test_node processes
+#         against ground participants) and the HIL's UDP hub
+# Usage: scripts/sanitize.sh [asan] [tsan]   (default: both)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+jobs="$(nproc)"
+unit='core_tests|test_drivers|test_hal|endcap_app_tests|mailbox_tests|comms_tests|msgs_tests|sim_tests|evolve_tests|hil_unit_tests'
+
+run_asan() {
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j "$jobs" --target \
+    core_tests test_drivers test_hal endcap_app_tests mailbox_tests comms_tests msgs_tests sim_tests evolve_tests \
+    hil_unit_tests ground_cli_tests
+  ctest --preset asan -L "^($unit)\$"
+  ctest --preset asan -R 'RealEndcaps|EndcapProcess'
+}
+
+run_tsan() {
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan -j "$jobs" --target mailbox_tests hil_unit_tests ground_dds_tests
+  ctest --preset tsan -L '^(mailbox_tests|hil_unit_tests|ground_dds_tests)$'
+}
+
+for what in "${@:-asan tsan}"; do
+  for w in $what; do
+    start=$(date +%s)
+    "run_$w"
+    echo "sanitize: $w took $(( $(date +%s) - start )) s"
+  done
+done
