@@ -12,11 +12,14 @@
 #include "cli/commands.hpp"
 #include "cli/shipped_policy.hpp"
 #include "cli/stop_signals.hpp"
+#include "cli/view_options.hpp"
+#include "hil/dds_domain.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
 #include "sim/policy.hpp"
+#include "view/modes.hpp"
 
 namespace tensegrity::cli {
 namespace {
@@ -40,6 +43,9 @@ struct HilArgs {
   std::string cable_failure = "drive";
   bool keep = false;
   bool json = false;
+  bool view = false;
+  double view_wait_s = 60.0;
+  ViewServerArgs view_server;
 };
 
 hil::HilOptions make_options(const HilArgs& a) {
@@ -72,11 +78,36 @@ hil::HilOptions make_options(const HilArgs& a) {
   return o;
 }
 
+// `--view`: the live page of this run, served while it runs. The view needs the
+// run's DDS domain before the run leases it, so a free one is chosen here; another
+// run taking it in between fails this one with a clear "domain in use".
+std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& o, const sim::Robot& robot) {
+  if (!args.view) return nullptr;
+  if (o.provision != hil::Provision::dds) throw CommandError(2, "hil: --view needs --provision dds (the end caps' DDS link)");
+  if (o.dds_domain < 0) o.dds_domain = hil::DomainLease(-1).domain();
+  std::unique_ptr<view::LiveView> v;
+  try {
+    v = std::make_unique<view::LiveView>(robot, o.dds_domain, to_server_options(args.view_server));
+  } catch (const std::exception& e) {
+    throw CommandError(2, std::string("hil --view: ") + e.what());
+  }
+  std::fprintf(stderr, "view: live page of this run (DDS domain %d) at %s\n", o.dds_domain, v->url().c_str());
+  if (args.view_wait_s > 0) {
+    std::fprintf(stderr, "view: the run starts when a page is open (at most %.0f s)\n", args.view_wait_s);
+    if (!v->wait_for_page(args.view_wait_s)) std::fprintf(stderr, "view: no page yet, starting anyway\n");
+  }
+  return v;
+}
+
 void run_hil_command(const HilArgs& args) {
   // Ctrl-C ends the run in order: the children are shut down, the temp dir removed.
   const StopOnSignals stop;
   hil::HilOptions options = make_options(args);
   options.stop = stop.token();
+  // Before the run raises this thread's priority: the view's threads stay ordinary.
+  const auto page = open_view(args, options, sim::load_robot(options.robot.empty()
+                                                                 ? sim::robot_path_for_policy(options.policy)
+                                                                 : options.robot));
   const hil::HilResult r = hil::run_hil(options);
   if (args.json) {
     std::printf("%s\n", hil::to_json(r).dump(2).c_str());
@@ -121,6 +152,12 @@ void add_hil_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"drive", "spool", "seize"}));
   cmd->add_flag("--keep", args->keep, "Keep the run directory (configs, stores, logs)");
   cmd->add_flag("--json", args->json, "Print one JSON object");
+  cmd->add_flag("--view", args->view, "Serve the live page of this run (tensegrity view --live on its domain)");
+  cmd->add_option("--view-wait", args->view_wait_s, "--view: seconds to wait for a page before starting (0: none)")
+      ->capture_default_str()->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--view-port", args->view_server.port, "--view: HTTP port of the page")->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--view-bind", args->view_server.bind, "--view: address to listen on")->capture_default_str();
   cmd->callback([args] { run_hil_command(*args); });
 }
 

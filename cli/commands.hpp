@@ -35,5 +35,7 @@ void add_record_command(CLI::App& app);
 // The HIL emulator (hil/): `hil`, and `bench hil` added by add_bench_command.
 void add_hil_command(CLI::App& app);
 void add_bench_hil_command(CLI::App& bench);
+// The web view (view/).
+void add_view_command(CLI::App& app);
 
 }  // namespace tensegrity::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_status_command(app);
   tensegrity::cli::add_record_command(app);
   tensegrity::cli::add_hil_command(app);
+  tensegrity::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,6 +11,10 @@ Recorder::Recorder(const std::filesystem::path& path, const sim::Model& model) :
   std::fputs("time_s,centre_x_m,centre_y_m,centre_z_m", file_);
   for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",rest_length_m_%d", c);
   for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",tension_n_%d", c);
+  // Every end cap's position and the energies, named as in `tensegrity sim
+  // --telemetry`: what `tensegrity view` needs to draw the robot.
+  for (int i = 0; i < model.robot().node_count(); ++i) std::fprintf(file_, ",node%d_x_m,node%d_y_m,node%d_z_m", i, i, i);
+  std::fputs(",kinetic_energy_j,gravity_energy_j,elastic_energy_j", file_);
   std::fputc('\n', file_);
 }
 
@@ -23,6 +27,8 @@ void Recorder::record(double time_s, const sim::Model& model) {
   std::fprintf(file_, "%.3f,%.6f,%.6f,%.6f", time_s, centre.x(), centre.y(), centre.z());
   for (double r : model.rest_length_m()) std::fprintf(file_, ",%.6f", r);
   for (double t : model.tension_n()) std::fprintf(file_, ",%.3f", t);
+  for (const auto& p : model.node_positions()) std::fprintf(file_, ",%.5f,%.5f,%.5f", p.x(), p.y(), p.z());
+  std::fprintf(file_, ",%.4f,%.4f,%.4f", model.kinetic_energy_j(), model.gravity_energy_j(), model.elastic_energy_j());
   std::fputc('\n', file_);
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// Per-tick CSV of a HIL run: time, centre, and per cable rest length and tension,
-// after each physics step. Buffered through one FILE*: a 60 s run is 60,000 rows.
+// Per-tick CSV of a HIL run: time, centre, per cable rest length and tension, every
+// end cap's position and the energies, after each physics step. Buffered through
+// one FILE*: a 60 s run is 60,000 rows.
 #pragma once
 
 #include <cstdio>

@@ -4,6 +4,7 @@
 # --evolve), simulate it in-process, then roll it with 12 real end-cap firmware
 # processes against the ODE model (HIL, lockstep), and report: distance, per end
 # cap summary, and a plot (out/hil-run.png).
+# It ends by printing the command that replays the run in a browser (tensegrity view).
 #   scripts/run.sh [--evolve] [--duration S]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -42,3 +43,7 @@ echo "== HIL: 12 endcap processes over CAN-over-UDP against the ODE model, locks
   --record out/hil-run.csv
 # Debian's interpreter: it is the one python3-matplotlib installs into.
 /usr/bin/python3 tools/plot_run.py out/hil-run.csv out/hil-run.png
+robot=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["robot"])' "$policy")
+echo
+echo "== watch the run in a browser (3D replay with plots; docs/view.md):"
+echo "   $tensegrity view out/hil-run.csv --robot robots/$robot.json    # then open http://127.0.0.1:8080/"

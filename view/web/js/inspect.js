@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: Apache-2.0
+// window.tensegrityView: a read-only look into the page for tests and curious
+// users (the browser test reads it; nothing in it changes the page or the robot).
+export const stats = {
+  openMs: null, // navigation start to the first frame drawn with data
+  fps: 0, // frames drawn per second while playing, last full second
+  framesDrawn: 0,
+};
+
+export const live = {
+  connected: false,
+  connects: 0,
+  samples: 0,
+  statusEvents: 0,
+  latenciesMs: [], // sample (end cap's host time) to its arrival in the page
+  endcapsSeen: 0,
+};
+
+export const evolve = { generations: 0, state: null, replayVersion: 0 };
+
+// The player on screen (replay, or the evolution's best team once loaded).
+let currentPlayer = null;
+export function setPlayer(p) { currentPlayer = p; }
+
+export function install(mode, sceneRef) {
+  const playerRef = () => currentPlayer;
+  const percentile = (values, p) => {
+    if (values.length === 0) return null;
+    const s = [...values].sort((a, b) => a - b);
+    return s[Math.min(s.length - 1, Math.floor((p / 100) * s.length))];
+  };
+  window.tensegrityView = Object.freeze({
+    mode,
+    get ready() { return !!sceneRef(); },
+    counts: () => (sceneRef() ? sceneRef().counts() : null),
+    sampleCanvas: () => (sceneRef() ? sceneRef().samplePixels() : null),
+    robotCentre: () => (sceneRef() ? sceneRef().centre().toArray() : null),
+    time: () => (playerRef() ? playerRef().time : null),
+    frame: () => (playerRef() ? playerRef().frame : null),
+    playing: () => (playerRef() ? playerRef().playing : false),
+    stats: () => ({ ...stats }),
+    live: () => ({
+      ...live,
+      latenciesMs: undefined,
+      latency: {
+        count: live.latenciesMs.length,
+        p50: percentile(live.latenciesMs, 50),
+        p95: percentile(live.latenciesMs, 95),
+        max: live.latenciesMs.length ? Math.max(...live.latenciesMs) : null,
+      },
+    }),
+    evolve: () => ({ ...evolve }),
+  });
+}
