@@ -226,7 +226,7 @@ EvolveOutcome evolve(const EvolveArgs& args, const sim::evolve::EvolveConfig& co
                       throw CommandError(3, e.what());
                     }
                   }(),
-                  sim::evolve::TeamResult{}, 0.0, 0};
+                  sim::evolve::TeamResult{}, 0.0, 0, sim::EpisodeResult{}};
   progress.finish();
   for (const auto& w : o.result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
   const std::vector<sim::evolve::Team> final_team{o.result.evolution.best().team};
