@@ -7,6 +7,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -128,7 +129,26 @@ void LiveBridge::on_telemetry_sample(const void* sample, std::int64_t received_n
   list("commanded_m", [&](std::size_t k) { return t.commanded_rest_length_m()[k]; });
   list("measured_m", [&](std::size_t k) { return t.measured_rest_length_m()[k]; });
   json += '}';
-  hub_.publish("telemetry", json);
+  std::lock_guard lock(mutex_);
+  std::string& slot = pending_[static_cast<std::size_t>(e)];
+  if (!slot.empty()) ++superseded_;
+  slot = std::move(json);
+}
+
+void LiveBridge::publish_frame() {
+  std::string frame;
+  {
+    std::lock_guard lock(mutex_);
+    for (std::string& s : pending_) {
+      if (s.empty()) continue;
+      frame += frame.empty() ? "[" : ",";
+      frame += s;
+      s.clear();
+    }
+  }
+  if (frame.empty()) return;
+  frame += ']';
+  hub_.publish("telemetry", frame);
 }
 
 void LiveBridge::on_heartbeat_sample(const void* sample, std::int64_t received_ns) {
@@ -165,18 +185,31 @@ std::string LiveBridge::status_json() const {
     endcaps.push_back(j);
   }
   return nlohmann::json{{"domain", options_.domain}, {"now_host_ms", static_cast<double>(now) / 1e6},
+                        {"frame_rate_hz", options_.frame_rate_hz}, {"superseded", superseded_},
                         {"endcaps", endcaps}}
       .dump();
 }
 
 void LiveBridge::status_loop() {
-  const auto period = std::chrono::duration<double>(1.0 / options_.status_rate_hz);
+  using clock = std::chrono::steady_clock;
+  const auto frame_period = std::chrono::duration_cast<clock::duration>(
+      std::chrono::duration<double>(1.0 / options_.frame_rate_hz));
+  const auto status_period = std::chrono::duration_cast<clock::duration>(
+      std::chrono::duration<double>(1.0 / options_.status_rate_hz));
+  auto next_frame = clock::now();
+  auto next_status = next_frame;
   std::unique_lock lock(mutex_);
   while (!stopping_) {
     lock.unlock();
-    hub_.publish("status", status_json());
+    const auto now = clock::now();
+    if (now >= next_status) {
+      hub_.publish("status", status_json());
+      next_status = now + status_period;
+    }
+    publish_frame();
+    next_frame = std::max(next_frame + frame_period, now);  // no burst after a stall
     lock.lock();
-    stop_cv_.wait_for(lock, period, [this] { return stopping_; });
+    stop_cv_.wait_until(lock, std::min(next_frame, next_status), [this] { return stopping_; });
   }
 }
 

@@ -13,6 +13,7 @@ export const live = {
   samples: 0,
   statusEvents: 0,
   latenciesMs: [], // sample (end cap's host time) to its arrival in the page
+  viewLatenciesMs: [], // the view's own part: its DDS receive to the page
   endcapsSeen: 0,
 };
 
@@ -39,16 +40,21 @@ export function install(mode, sceneRef) {
     frame: () => (playerRef() ? playerRef().frame : null),
     playing: () => (playerRef() ? playerRef().playing : false),
     stats: () => ({ ...stats }),
-    live: () => ({
-      ...live,
-      latenciesMs: undefined,
-      latency: {
-        count: live.latenciesMs.length,
-        p50: percentile(live.latenciesMs, 50),
-        p95: percentile(live.latenciesMs, 95),
-        max: live.latenciesMs.length ? Math.max(...live.latenciesMs) : null,
-      },
-    }),
+    live: () => {
+      const summary = (v) => ({
+        count: v.length,
+        p50: percentile(v, 50),
+        p95: percentile(v, 95),
+        max: v.length ? Math.max(...v) : null,
+      });
+      return {
+        ...live,
+        latenciesMs: undefined,
+        viewLatenciesMs: undefined,
+        latency: summary(live.latenciesMs),
+        viewLatency: summary(live.viewLatenciesMs),
+      };
+    },
     evolve: () => ({ ...evolve }),
   });
 }

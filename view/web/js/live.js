@@ -66,15 +66,20 @@ export class LiveView {
       if (es.readyState === EventSource.CLOSED) setTimeout(() => this.connect(), 1000);
     };
     es.addEventListener('status', (e) => this.onStatus(JSON.parse(e.data)));
-    es.addEventListener('telemetry', (e) => this.onTelemetry(JSON.parse(e.data)));
+    // A frame: each end cap's newest sample since the last one (live_bridge.hpp).
+    es.addEventListener('telemetry', (e) => JSON.parse(e.data).forEach((s) => this.onTelemetry(s)));
   }
 
   onTelemetry(s) {
     const arrivedMs = performance.now();
     live.samples++;
-    if (this.offsetMs !== null && s.sample_host_ms > 0) {
-      live.latenciesMs.push(arrivedMs + this.offsetMs - s.sample_host_ms);
-      if (live.latenciesMs.length > MAX_LATENCIES) live.latenciesMs.splice(0, MAX_LATENCIES / 2);
+    if (this.offsetMs !== null) {
+      const keep = (list, ms) => {
+        list.push(ms);
+        if (list.length > MAX_LATENCIES) list.splice(0, MAX_LATENCIES / 2);
+      };
+      if (s.sample_host_ms > 0) keep(live.latenciesMs, arrivedMs + this.offsetMs - s.sample_host_ms);
+      keep(live.viewLatenciesMs, arrivedMs + this.offsetMs - s.received_host_ms);
     }
     s.cables.forEach((c, k) => {
       this.tension[c] = s.tension_n[k];
@@ -94,8 +99,10 @@ export class LiveView {
     });
     document.querySelector('#endcaps tbody').innerHTML = rows.join('');
     const l = window.tensegrityView.live().latency;
+    const v = window.tensegrityView.live().viewLatency;
     document.getElementById('latency').textContent = l.count
-      ? `sample to page: median ${l.p50.toFixed(1)} ms, 95 % ${l.p95.toFixed(1)} ms (${l.count} samples)`
+      ? `sample to page: median ${l.p50.toFixed(1)} ms, 95 % ${l.p95.toFixed(1)} ms (${l.count} samples); ` +
+        `of which the view: median ${v.p50.toFixed(1)} ms`
       : 'waiting for telemetry (end caps with a synchronized clock)';
   }
 
