@@ -121,6 +121,11 @@ def test_live(args, driver, tmp):
               f"max {latency['max']:.1f} over {latency['count']} samples ({args.hil_mode} HIL, sample to page)")
         print(f"MEASURE live_view_latency_ms median {own['p50']:.1f} p95 {own['p95']:.1f} max {own['max']:.1f} "
               f"over {own['count']} samples (the view's DDS receive to the page)")
+        for name in ("latencyRecent", "viewLatencyRecent"):
+            r = view_state(driver, f"live().{name}")
+            if r["count"]:
+                print(f"MEASURE live_{name} median {r['p50']:.1f} p95 {r['p95']:.1f} max {r['max']:.1f} "
+                      f"over {r['count']} samples (the last 5 s)")
         assert latency["count"] > 100, f"latency samples {latency}"
         screenshot(driver, args.screenshots, "live.png")
         # A second view of the same run, stopped and started again under the page.

@@ -41,18 +41,21 @@ export function install(mode, sceneRef) {
     playing: () => (playerRef() ? playerRef().playing : false),
     stats: () => ({ ...stats }),
     live: () => {
-      const summary = (v) => ({
-        count: v.length,
-        p50: percentile(v, 50),
-        p95: percentile(v, 95),
-        max: v.length ? Math.max(...v) : null,
-      });
+      // Entries are [arrival ms, latency ms]; `recent`: the last 5 s only (a page
+      // busy building its scene at first holds the first samples back).
+      const summary = (entries, recent) => {
+        const since = performance.now() - 5000;
+        const v = (recent ? entries.filter((e) => e[0] >= since) : entries).map((e) => e[1]);
+        return { count: v.length, p50: percentile(v, 50), p95: percentile(v, 95), max: v.length ? Math.max(...v) : null };
+      };
       return {
         ...live,
         latenciesMs: undefined,
         viewLatenciesMs: undefined,
-        latency: summary(live.latenciesMs),
-        viewLatency: summary(live.viewLatenciesMs),
+        latency: summary(live.latenciesMs, false),
+        viewLatency: summary(live.viewLatenciesMs, false),
+        latencyRecent: summary(live.latenciesMs, true),
+        viewLatencyRecent: summary(live.viewLatenciesMs, true),
       };
     },
     evolve: () => ({ ...evolve }),

@@ -10,6 +10,10 @@ import { live, stats } from './inspect.js';
 
 const WINDOW_S = 30;
 const MAX_LATENCIES = 20000;
+// Live frames are drawn at most this often: in software WebGL beside a real-time
+// HIL every frame drawn is CPU the page's event handling waits for (drawn at the
+// display's rate, the page took seconds to handle each sample).
+const MIN_FRAME_MS = 100;
 
 async function clockOffsetMs() {
   // Host clock minus performance.now(), from the quickest of a few round trips.
@@ -75,7 +79,7 @@ export class LiveView {
     live.samples++;
     if (this.offsetMs !== null) {
       const keep = (list, ms) => {
-        list.push(ms);
+        list.push([arrivedMs, ms]);
         if (list.length > MAX_LATENCIES) list.splice(0, MAX_LATENCIES / 2);
       };
       if (s.sample_host_ms > 0) keep(live.latenciesMs, arrivedMs + this.offsetMs - s.sample_host_ms);
@@ -123,8 +127,9 @@ export class LiveView {
     this.plots.rest.set(h.t, per(h.rest));
   }
 
-  tick() {
-    if (this.dirty) {
+  tick(nowMs) {
+    if (this.dirty && !(nowMs - this.lastDrawMs < MIN_FRAME_MS)) {
+      this.lastDrawMs = nowMs;
       this.scene.update(null, this.tension);
       this.scene.render();
       this.dirty = false;
