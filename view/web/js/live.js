@@ -102,11 +102,11 @@ export class LiveView {
         `<td>${e.heartbeat_age_s.toFixed(2)} s</td><td>${e.policy || '-'}</td><td>${e.telemetry}</td></tr>`;
     });
     document.querySelector('#endcaps tbody').innerHTML = rows.join('');
-    const l = window.tensegrityView.live().latency;
-    const v = window.tensegrityView.live().viewLatency;
+    const l = window.tensegrityView.live().latencyRecent;
+    const v = window.tensegrityView.live().viewLatencyRecent;
     document.getElementById('latency').textContent = l.count
-      ? `sample to page: median ${l.p50.toFixed(1)} ms, 95 % ${l.p95.toFixed(1)} ms (${l.count} samples); ` +
-        `of which the view: median ${v.p50.toFixed(1)} ms`
+      ? `sample to page, last 5 s: median ${l.p50.toFixed(1)} ms, 95 % ${l.p95.toFixed(1)} ms ` +
+        `(${l.count} samples); of which the view: median ${v.p50.toFixed(1)} ms`
       : 'waiting for telemetry (end caps with a synchronized clock)';
   }
 
