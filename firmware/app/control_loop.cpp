@@ -18,8 +18,6 @@ using core::FaultCause;
 namespace {
 constexpr double kNsToS = 1e-9;
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
-
 bool is_sync(const CanFrame& f) { return !f.extended && !f.rtr && f.id == canopen::kSyncCobId && f.dlc <= 1; }
 
 bool quick_stops(FaultCause c) {
@@ -33,35 +31,6 @@ bool quick_stops(FaultCause c) {
   }
 }
 }  // namespace
-
-LoopSettings make_loop_settings(const EndcapAppConfig& c) {
-  LoopSettings s;
-  s.core.motor_count = c.motor_count;
-  s.core.limits = c.limits;
-  s.core.initial_rest_length_m = c.initial_rest_length_m;
-  s.master.drive_node_id = c.drive_node_ids[0];
-  s.master.drive_count = static_cast<std::uint8_t>(c.motor_count);
-  for (std::uint32_t i = 1; i < c.motor_count; ++i) s.master.extra_drive_node_ids[i - 1] = c.drive_node_ids[i];
-  s.master.load_cell_node_id = c.load_cell_node_id;
-  s.master.use_load_cell = c.use_load_cell;
-  s.master.drive_heartbeat_timeout_ns = to_ns(c.drive_heartbeat_timeout_s);
-  s.master.load_cell_heartbeat_timeout_ns = to_ns(c.load_cell_heartbeat_timeout_s);
-  s.master.spool = c.spool();
-  s.master.master_node_id = c.endcap_node_id;
-  s.master.producer_heartbeat_period_ns = to_ns(c.endcap_heartbeat_s);
-  s.master.drive_consumer_heartbeat_ms = static_cast<std::uint16_t>(std::llround(c.drive_consumer_heartbeat_s * 1e3));
-  s.master.drive_abort_connection = c.drive_abort_connection;
-  s.safety.drive_position_timeout_ns = to_ns(c.drive_position_timeout_s);
-  s.safety.motor_count = c.motor_count;
-  s.safety.use_load_cell = c.use_load_cell;
-  s.safety.load_cell_sample_timeout_ns = to_ns(c.load_cell_sample_timeout_s);
-  s.mode = c.mode;
-  s.period_ns = c.period_ns();
-  s.start_on_boot = c.start_on_boot;
-  const double window = std::ceil(c.stats_log_period_s * c.loop_rate_hz);
-  s.stats_window_cycles = window < 1.0 ? 1 : static_cast<std::uint64_t>(window);
-  return s;
-}
 
 ControlLoop::ControlLoop(CanBus& bus, Clock& clock, HostLink& host, const LoopSettings& settings)
     : bus_(bus),
