@@ -88,6 +88,14 @@ class Reader {
   std::string path_;
 };
 
+// Bounds of plausible geometry: past them ODE aborts or the model runs with tensions
+// of 1e9 N (a node at 1e308 m, or a thousand kilometres away, was accepted before).
+// Generous on purpose: SUPERball's struts are 1.5-1.7 m and 2-4 kg.
+constexpr double kMaxCoordinateM = 100.0;
+constexpr double kMaxStrutLengthM = 20.0;
+constexpr double kMaxStrutMassKg = 1000.0;
+constexpr double kMaxStrutRadiusM = 1.0;
+
 void check_pair(const Reader& r, const json& pair, const std::string& field, int node_count,
                 int& a, int& b) {
   if (!pair.is_array() || pair.size() != 2) r.fail(field, "must be a pair of node indices");
@@ -157,7 +165,11 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
     const std::string field = "nodes_m[" + std::to_string(i) + "]";
     if (!nodes[i].is_array() || nodes[i].size() != 3) r.fail(field, "must be [x, y, z]");
     Eigen::Vector3d p;
-    for (int k = 0; k < 3; ++k) p[k] = r.as_number(nodes[i][k], field + "[" + std::to_string(k) + "]");
+    for (int k = 0; k < 3; ++k) {
+      const std::string coordinate = field + "[" + std::to_string(k) + "]";
+      p[k] = r.as_number(nodes[i][k], coordinate);
+      if (std::abs(p[k]) > kMaxCoordinateM) r.fail(coordinate, "must be within +-100 m of the origin");
+    }
     robot.nodes_m.push_back(p);
   }
   const int n = robot.node_count();
@@ -165,6 +177,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   const Reader strut = r.child("strut");
   robot.strut_mass_kg = strut.positive("mass_kg");
   robot.strut_radius_m = strut.positive("radius_m");
+  if (robot.strut_mass_kg > kMaxStrutMassKg) strut.fail("mass_kg", "must be at most 1000 kg");
+  if (robot.strut_radius_m > kMaxStrutRadiusM) strut.fail("radius_m", "must be at most 1 m");
   robot.axial_damping_n_m_s = strut.non_negative_or("axial_damping_n_m_s", 0.0);
 
   const json& struts = r.array("struts");
@@ -182,6 +196,9 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
     }
     if ((robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm() < 4.0 * robot.strut_radius_m) {
       r.fail(field, "strut is shorter than four radii");
+    }
+    if ((robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm() > kMaxStrutLengthM) {
+      r.fail(field, "strut is longer than 20 m");
     }
     robot.struts.push_back(s);
   }

@@ -95,6 +95,25 @@ TEST(Robot, CableAlongOneStrutNamed) {
   EXPECT_THAT(error_of(doc), HasSubstr("cables[7].nodes: both ends are on struts[0]"));
 }
 
+TEST(Robot, AbsurdGeometryNamed) {
+  json doc = superball_json();
+  doc["nodes_m"][3][1] = 1e308;
+  EXPECT_THAT(error_of(doc), HasSubstr("nodes_m[3][1]: must be within +-100 m of the origin"));
+  doc = superball_json();
+  doc["nodes_m"][5][0] = 1e6;  // a thousand kilometres away
+  EXPECT_THAT(error_of(doc), HasSubstr("nodes_m[5][0]: must be within +-100 m"));
+  doc = superball_json();
+  doc["nodes_m"][0] = json::array({-40.0, 0.0, 0.0});
+  doc["nodes_m"][1] = json::array({40.0, 0.0, 0.0});  // struts[0] joins nodes 0 and 1
+  EXPECT_THAT(error_of(doc), HasSubstr("strut is longer than 20 m"));
+  doc = superball_json();
+  doc["strut"]["mass_kg"] = 1e9;
+  EXPECT_THAT(error_of(doc), HasSubstr("strut.mass_kg: must be at most 1000 kg"));
+  doc = superball_json();
+  doc["strut"]["radius_m"] = 5.0;
+  EXPECT_THAT(error_of(doc), HasSubstr("strut.radius_m: must be at most 1 m"));
+}
+
 TEST(Robot, OwnerNotAnEndNamed) {
   json doc = superball_json();
   doc["cables"][0]["owner"] = 7;  // cable 0 joins 0 and 4
