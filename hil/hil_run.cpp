@@ -149,6 +149,11 @@ struct RunParts {
   std::unique_ptr<WorldStepper> stepper;
   std::unique_ptr<Recorder> recorder;
   bool running = false;
+  // The devices at the run's last physics step. What they do after it belongs to
+  // the shutdown: in real time the end caps' drives are served until their programs
+  // exit, and a drive whose end cap took longer than its consumer heartbeat to exit
+  // is in quick stop by then (seen once in CI-like runs of HilRejoin/realtime_dds).
+  std::vector<EndcapDeviceSummary> devices_at_end;
 };
 
 void load_inputs(const HilOptions& options, RunParts& parts) {
@@ -235,6 +240,7 @@ void run_phases(const HilOptions& options, RunParts& parts, HilResult& result) {
   provisioner.begin_run();
   parts.running = true;
   stepper.run(options.duration_s);
+  for (int e = 0; e < parts.robot->endcap_count(); ++e) parts.devices_at_end.push_back(stepper.devices(e).summary());
   // Real time: the end caps' own clocks keep running; serve them while they stop
   // (first thing: a sample 20 ms late is a fault), then the provisioner's threads.
   launcher.terminate_all();
@@ -257,7 +263,11 @@ EndcapSummary summarize(const EndcapProcessReport& r, const RunParts& parts) {
   s.fault = stat_or<std::string>(r.stats, "fault", "unknown (no stats)");
   s.bring_up = stat_or<std::string>(r.stats, "bring_up", "");
   if (parts.hub) s.bus = parts.hub->counters(r.endcap);
-  if (parts.stepper) s.devices = parts.stepper->devices(r.endcap).summary();
+  if (static_cast<std::size_t>(r.endcap) < parts.devices_at_end.size()) {
+    s.devices = parts.devices_at_end[static_cast<std::size_t>(r.endcap)];
+  } else if (parts.stepper) {
+    s.devices = parts.stepper->devices(r.endcap).summary();  // the run ended early
+  }
   const std::string log = parts.launcher->log_text(r.endcap);
   s.host_losses = count_lines(log, "host LOST");
   s.host_returns = count_lines(log, "host back");
