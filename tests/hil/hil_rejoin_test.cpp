@@ -32,7 +32,11 @@ TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
   // Lockstep: no time passes while the new program starts, so it is back, and
   // through the gate, at the first period boundary after its bring-up (4 s), on any
   // host however loaded.
-  HilOptions o = options(10.0, c.provision);
+  // Real time: 20 s, so the restarted program has 14 s to boot, be discovered and
+  // take its start: beside a real-time HIL on 2 cores its first start went
+  // unacknowledged for the command's 5 s (a fresh-clone CI run here) and the retry
+  // needs time too.
+  HilOptions o = options(c.mode == StepperMode::lockstep ? 10.0 : 20.0, c.provision);
   o.mode = c.mode;
   o.scenario.events = kill_and_restart(4, kill_s, kill_s + 0.5);
   const HilResult r = run_hil(o);
