@@ -15,6 +15,7 @@ import tempfile
 import time
 
 from selenium.webdriver.common.by import By
+from selenium.common.exceptions import TimeoutException
 from selenium.webdriver.common.keys import Keys
 
 from browser_support import (Process, check_scene, chromium, free_port, http, screenshot, view_state, wait_for,
@@ -122,7 +123,11 @@ def test_live(args, driver, tmp):
         print(f"MEASURE live_view_latency_ms median {own['p50']:.1f} p95 {own['p95']:.1f} max {own['max']:.1f} "
               f"over {own['count']} samples (the view's DDS receive to the page)")
         for name in ("latencyRecent", "viewLatencyRecent"):
-            r = view_state(driver, f"live().{name}")
+            try:
+                r = view_state(driver, f"live().{name}")
+            except TimeoutException:  # a measurement, not a check: a starved page may not answer
+                print(f"MEASURE live_{name} not measured (the page did not answer in time)")
+                continue
             if r["count"]:
                 print(f"MEASURE live_{name} median {r['p50']:.1f} p95 {r['p95']:.1f} max {r['max']:.1f} "
                       f"over {r['count']} samples (the last 5 s)")

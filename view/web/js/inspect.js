@@ -45,7 +45,14 @@ export function install(mode, sceneRef) {
       // busy building its scene at first holds the first samples back).
       const summary = (entries, recent) => {
         const since = performance.now() - 5000;
-        const v = (recent ? entries.filter((e) => e[0] >= since) : entries).map((e) => e[1]);
+        let v;
+        if (recent) {
+          // Entries are in arrival order: walk back from the newest only.
+          v = [];
+          for (let i = entries.length - 1; i >= 0 && entries[i][0] >= since; i--) v.push(entries[i][1]);
+        } else {
+          v = entries.map((e) => e[1]);
+        }
         return { count: v.length, p50: percentile(v, 50), p95: percentile(v, 95), max: v.length ? Math.max(...v) : null };
       };
       return {
