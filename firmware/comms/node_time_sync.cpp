@@ -33,12 +33,19 @@ void EndcapNode::on_time_sync_reply(Dds& d) {
     if (!info.valid_data || reply.endcap_id() != config_.endcap_id) continue;
     if (reply.format_version() != msgs::kFormatVersion) continue;
     std::uint64_t refused = 0;
+    std::uint64_t unknown = 0;
     {
       std::lock_guard lock(mutex_);
       const TimeSyncVerdict verdict = sync_.on_reply(reply.nonce(), reply.t2_ns(), reply.t3_ns(), t4);
       if (verdict == TimeSyncVerdict::implausible) refused = sync_.counters().implausible;
+      if (verdict == TimeSyncVerdict::unknown_nonce) unknown = sync_.counters().unknown_nonce;
     }
+    // Both say why an end cap stays unsynchronized ("see their logs").
     if (refused % 100 == 1) log("refused an implausible time-sync reply (%llu so far)", static_cast<unsigned long long>(refused));
+    if (unknown % 100 == 1) {
+      log("ignored a time-sync reply to no open request: late or replayed (%llu so far)",
+          static_cast<unsigned long long>(unknown));
+    }
   }
 }
 

@@ -85,7 +85,7 @@ TimeSyncVerdict TimeSyncClient::on_reply(std::uint64_t nonce, std::int64_t t2_ns
 void TimeSyncClient::settle(std::int64_t now_ns) {
   for (Pending& p : pending_) {
     // t1 is this end cap's own clock: no wire value in this subtraction.
-    if (p.used && now_ns - p.t1_ns > limits_.settle_after_ns) settle_one(p);
+    if (p.used && now_ns - p.t1_ns > limits_.settle_after_ns()) settle_one(p);
   }
 }
 

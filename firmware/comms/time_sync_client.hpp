@@ -2,8 +2,9 @@
 // The end cap's side of the time sync, pure (the node sends and receives). Each
 // request carries a fresh random nonce; a reply counts only if it echoes the nonce
 // of one of this end cap's outstanding requests, and its t1 is this end cap's own
-// record, never the reply's. A reply is held until its request settles
-// (settle_after later) so that every answer to it is seen:
+// record, never the reply's. A reply is held until its request settles (once
+// no plausible answer can still come: max_round_trip + max_host_hold after it
+// was sent) so that every answer to it is seen:
 //
 // - implausible: t3 < t2, the host held it longer than max_host_hold, or a round
 //   trip < 0 or > max_round_trip: refused;
@@ -30,9 +31,11 @@ struct TimeSyncLimits {
   std::int64_t max_round_trip_ns = 500'000'000;
   std::int64_t max_host_hold_ns = 50'000'000;  // t3 - t2
   std::int64_t tolerance_ns = 1'000'000;       // added to every agreement bound
-  // A request settles this long after it was sent: answers later than that are
-  // unknown (their nonce is spent).
-  std::int64_t settle_after_ns = 50'000'000;
+  // A request settles when no plausible answer can still arrive; later answers
+  // are unknown (their nonce is spent). Settling sooner would drop replies the
+  // limits allow: on a loaded host (a real-time HIL beside a browser) round trips
+  // of 50-300 ms are common, and a 50 ms window left 9 of 12 end caps unsynced.
+  std::int64_t settle_after_ns() const { return max_round_trip_ns + max_host_hold_ns; }
 };
 
 enum class TimeSyncVerdict : std::uint8_t { held, unknown_nonce, implausible };

@@ -26,7 +26,7 @@ Answer honest(std::int64_t t1, std::int64_t offset = kHostAhead) {
 void exchange(TimeSyncClient& c, std::int64_t t1, std::initializer_list<Answer> answers) {
   const std::uint64_t nonce = c.start_request(t1);
   for (const Answer& a : answers) c.on_reply(nonce, a.t2, a.t3, a.t4);
-  c.settle(t1 + 100 * kMs);
+  c.settle(t1 + 600 * kMs);
 }
 
 TEST(TimeSyncClient, AnHonestHostSynchronizesItWithinTheRoundTrip) {
@@ -36,6 +36,22 @@ TEST(TimeSyncClient, AnHonestHostSynchronizesItWithinTheRoundTrip) {
   ASSERT_TRUE(c.estimator().synced());
   EXPECT_LE(std::llabs(c.estimator().best().offset_ns - kHostAhead), c.estimator().best().round_trip_ns / 2);
   EXPECT_EQ(c.counters().accepted, 1U);
+}
+
+TEST(TimeSyncClient, ASlowButPlausibleReplyCountsWhenItArrivesAfterOtherRequestsSettled) {
+  // A starved host: the reply takes 300 ms. The node settles every cycle; the
+  // request must still be open when its answer arrives.
+  TimeSyncClient c(42);
+  const std::int64_t t1 = 1000 * kMs;
+  const std::uint64_t nonce = c.start_request(t1);
+  c.settle(t1 + 100 * kMs);
+  c.settle(t1 + 250 * kMs);
+  const std::int64_t t2 = t1 + kHostAhead + 150 * kMs;
+  EXPECT_EQ(c.on_reply(nonce, t2, t2 + 20'000, t1 + 300 * kMs + 20'000), TimeSyncVerdict::held);
+  c.settle(t1 + 600 * kMs);
+  ASSERT_TRUE(c.estimator().synced());
+  EXPECT_EQ(c.counters().accepted, 1U);
+  EXPECT_EQ(c.estimator().best().round_trip_ns, 300 * kMs);
 }
 
 TEST(TimeSyncClient, RepliesWithoutTheNonceOfAnOutstandingRequestAreRefused) {
