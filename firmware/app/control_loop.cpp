@@ -26,6 +26,7 @@ bool quick_stops(FaultCause c) {
     case FaultCause::drive_lost:
     case FaultCause::emergency_stop:
     case FaultCause::node_rebooted:
+    case FaultCause::loop_stalled:
     case FaultCause::drive_disabled: return true;
     default: return false;
   }
@@ -74,15 +75,15 @@ void ControlLoop::latch(FaultCause cause, std::int64_t time_ns) {
   if (cause == FaultCause::none) return;
   const bool first = controller_.fault() == FaultCause::none;
   controller_.trip(cause);
+  // A drive that faulted, vanished, rebooted or fell out of operation enabled, a
+  // stalled loop or an operator's stop: the drives go to quick stop (decelerate,
+  // then hold with power on), also when a milder fault is latched already. Sensor
+  // faults (a stale position included: the drive is alive, its heartbeat watched)
+  // and over-tension keep the drives enabled, holding the last measured position.
+  if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
   if (!first) return;
   pending_start_ = false;
   hold_at_measured();
-  // A drive that faulted, vanished, rebooted or fell out of operation enabled, or
-  // an operator's stop: the drives go to quick stop (decelerate, then hold with
-  // power on). Sensor faults (a stale position included: the drive is alive, its
-  // heartbeat watched) and over-tension keep the drives enabled, holding the
-  // last measured position.
-  if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
   emit(AppEventKind::fault_latched, time_ns, cause);
 }
 
@@ -315,6 +316,14 @@ void ControlLoop::run_realtime_cycle() {
 
   const std::int64_t time_ns = wake_ns - origin_ns_;
   const double dt_s = static_cast<double>(time_ns - previous_time_ns_) * kNsToS;
+  // After a gap the drives may have stopped themselves (0x6007) while the cached
+  // states still say "operation enabled": latch before this cycle sends anything,
+  // or its "enable operation" would re-enable them (CiA 402 transition 16).
+  if (settings_.stall_limit_ns > 0 && time_ns - previous_time_ns_ > settings_.stall_limit_ns &&
+      master_.bring_up_step() == BringUpStep::done) {
+    ++status_.stalls;
+    latch(FaultCause::loop_stalled, time_ns);
+  }
   previous_time_ns_ = time_ns;
   drain_bus(time_ns);
   cycle(time_ns, dt_s);

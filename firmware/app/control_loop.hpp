@@ -38,6 +38,8 @@ struct LoopSettings {
   // After a clear, a drive gets this long to leave its fault state before the
   // state check trips again (the fault-reset handshake takes a few cycles).
   std::int64_t fault_reset_grace_ns = 200'000'000;
+  // Real time: a gap between cycles longer than this is a stall (0: not checked).
+  std::int64_t stall_limit_ns = 0;
   std::uint64_t stats_window_cycles = 10'000;
 };
 
@@ -74,6 +76,7 @@ struct AppEvent {
 struct LoopStatus {
   std::int64_t time_ns = 0;
   std::uint64_t cycles = 0;
+  std::uint64_t stalls = 0;        // realtime gaps longer than stall_limit_ns (each latches loop_stalled)
   std::uint64_t overruns = 0;      // a cycle ended after the next deadline (realtime) or took > period
   std::uint64_t late_wakeups = 0;  // woke more than half a period after the deadline
   std::uint64_t syncs_received = 0;

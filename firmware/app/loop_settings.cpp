@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The end cap's config (seconds, as people write them) -> the loop's settings
 // (nanoseconds and node ids, as the loop and the CANopen master use them).
+#include <algorithm>
 #include <cmath>
 
 #include "firmware/app/control_loop.hpp"
@@ -34,6 +35,10 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   s.mode = c.mode;
   s.period_ns = c.period_ns();
   s.start_on_boot = c.start_on_boot;
+  // The drives stop themselves once no heartbeat came for their consumer time,
+  // and the last one may have left a producer period before the loop stopped.
+  const std::int64_t consumer_ns = std::int64_t{s.master.drive_consumer_heartbeat_ms} * 1'000'000;
+  s.stall_limit_ns = consumer_ns > 0 ? std::max(consumer_ns - s.master.producer_heartbeat_period_ns, s.period_ns) : 0;
   const double window = std::ceil(c.stats_log_period_s * c.loop_rate_hz);
   s.stats_window_cycles = window < 1.0 ? 1 : static_cast<std::uint64_t>(window);
   return s;

@@ -81,6 +81,7 @@ void report_exit(const app::Endcap& endcap, const std::string& stats_path) {
       {"rate_hz", endcap.config().loop_rate_hz},
       {"cycles", s.cycles},
       {"overruns", s.overruns},
+      {"stalls", s.stalls},
       {"late_wakeups", s.late_wakeups},
       {"syncs_received", s.syncs_received},
       {"send_failures", s.send_failures},

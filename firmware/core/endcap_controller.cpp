@@ -16,6 +16,7 @@ const char* describe(FaultCause cause) noexcept {
     case FaultCause::node_rebooted: return "CANopen node rebooted";
     case FaultCause::drive_disabled: return "motor drive left operation enabled";
     case FaultCause::stale_position: return "motor drive position stale";
+    case FaultCause::loop_stalled: return "control loop stalled";
   }
   return "unknown fault";
 }

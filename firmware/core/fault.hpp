@@ -19,6 +19,7 @@ enum class FaultCause : std::uint8_t {
   node_rebooted,   // a drive or the load cell sent a boot-up after bring-up
   drive_disabled,  // a drive left operation enabled without being asked
   stale_position,  // no drive position newer than the configured age
+  loop_stalled,    // the real-time loop missed cycles for longer than its drives wait for its heartbeat
 };
 
 const char* describe(FaultCause cause) noexcept;

@@ -127,6 +127,41 @@ TEST(Supervision, EndCapHeartbeatComesFromTheLoopAndStopsWithIt) {
   EXPECT_EQ(b.drive1.state(), Cia402State::quick_stop_active);
 }
 
+// A loop that hung (SIGSTOP, a blocked driver) and resumes must not undo what the
+// drives did on their own: its cached states still say "operation enabled", and an
+// "enable operation" to a drive in quick stop is CiA 402's transition 16.
+TEST(Supervision, ALoopThatResumesAfterAStallLatchesAFaultAndLeavesItsDrivesStopped) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  for (int i = 0; i < 30; ++i) b.cycle();
+  for (int i = 0; i < 60; ++i) {
+    b.clock.advance_ns(b.settings.period_ns);
+    b.bus.tick();
+  }
+  ASSERT_EQ(b.drive0.state(), Cia402State::quick_stop_active);
+  b.cycle();
+  expect_safe_state(b, FaultCause::loop_stalled);
+  for (int i = 0; i < 200; ++i) b.cycle();
+  EXPECT_EQ(b.drive0.state(), Cia402State::quick_stop_active) << "not re-enabled without an operator";
+  EXPECT_EQ(b.drive1.state(), Cia402State::quick_stop_active);
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::loop_stalled) << "latched";
+  // An operator's clear brings them back.
+  b.host.commands.push_back({CommandKind::clear_fault, 0});
+  ASSERT_TRUE(b.run_until([&] { return b.loop->drives_enabled(); }, 500));
+  for (int i = 0; i < 100; ++i) b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
+}
+
+TEST(Supervision, AShortLateWakeUpIsNotAStall) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  for (int i = 0; i < 30; ++i) b.cycle();
+  b.clock.advance_ns(10 * b.settings.period_ns);  // 10 ms late: an overrun, the drives saw no gap
+  for (int i = 0; i < 100; ++i) b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
+  EXPECT_TRUE(b.running());
+}
+
 TEST(Supervision, DetectorsAllocateNothing) {
   AppBench b;
   b.drive0.controlwords.reserve(100'000);
