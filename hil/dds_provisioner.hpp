@@ -42,7 +42,9 @@ struct DdsProvisionerConfig {
   int domain = -1;                  // -1: lease a free one (DomainLease)
   std::string host_loss = "continue";  // the end caps' --host-loss
   StepperMode mode = StepperMode::lockstep;
-  double discovery_timeout_s = 15.0;  // every end cap's heartbeat with a synchronized clock
+  // Every end cap's heartbeat with a synchronized clock. Usually 1-6 s; a real-time
+  // HIL on 2 cores (1.3 of them at SCHED_FIFO) took up to 14.4 s (docs/hil.md).
+  double discovery_timeout_s = 30.0;
   double upload_timeout_s = 10.0;
   double command_timeout_s = 5.0;
   // Lockstep: physics step 0 is this many SYNCs after the freeze: a whole number of

@@ -47,7 +47,7 @@ struct HilOptions {
   int dds_domain = -1;                 // -1: a free one of the HIL's range (dds_domain.hpp)
   double hold_timeout_s = 60.0;        // dds: gate open to physics step 0
   bool keep_dir = false;
-  double dds_discovery_timeout_s = 15.0;  // dds: every end cap on the link, clock synchronized
+  double dds_discovery_timeout_s = 30.0;  // dds: every end cap on the link, clock synchronized
   std::vector<int> never_start;  // tests
   std::map<int, std::vector<std::string>> endcap_extra_args;  // tests: more arguments for an end cap
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).

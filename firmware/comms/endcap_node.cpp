@@ -25,6 +25,8 @@ namespace m = tensegrity_msgs::msg::dds_;
 namespace {
 constexpr int kInitialSyncBurst = 8;
 constexpr std::int64_t kInitialSyncSpacingNs = 25'000'000;
+// While unsynchronized the log says why, this often (a start is refused until then).
+constexpr std::int64_t kUnsyncedReportNs = 5'000'000'000;
 std::int64_t period_ns(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
 std::int64_t to_ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
 }  // namespace
@@ -84,6 +86,7 @@ void EndcapNode::start() {
   next_telemetry_ns_ = now;
   next_heartbeat_ns_ = now;
   next_sync_ns_ = now;
+  next_unsynced_report_ns_ = now + kUnsyncedReportNs;
   loop_progress_ns_ = now;
   running_.store(true);
   // The remaining readers wake the node thread; created after dds_ is set.
@@ -190,6 +193,10 @@ void EndcapNode::service(std::int64_t now) {
     send_time_sync_request();
     const bool burst = sync_sequence_ < kInitialSyncBurst;
     next_sync_ns_ = now + (burst ? kInitialSyncSpacingNs : to_ns(config_.time_sync_interval_s));
+  }
+  if (now >= next_unsynced_report_ns_) {
+    next_unsynced_report_ns_ = now + kUnsyncedReportNs;
+    report_if_unsynced();
   }
 }
 

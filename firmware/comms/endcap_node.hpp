@@ -119,6 +119,7 @@ class EndcapNode final : public app::HostLink {
   void report_link_cut();
   // node_time_sync.cpp
   void send_time_sync_request();
+  void report_if_unsynced();
   void on_time_sync_reply(Dds& dds);  // DDS listener thread
   void log(const char* format, ...) const __attribute__((format(printf, 2, 3)));
 
@@ -155,6 +156,7 @@ class EndcapNode final : public app::HostLink {
   std::int64_t next_telemetry_ns_ = 0;
   std::int64_t next_heartbeat_ns_ = 0;
   std::int64_t next_sync_ns_ = 0;
+  std::int64_t next_unsynced_report_ns_ = 0;
   std::uint64_t refused_format_ = 0;
   bool link_was_cut_ = false;
   std::uint64_t loop_progress_seen_ = 0;

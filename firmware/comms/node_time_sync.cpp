@@ -23,6 +23,20 @@ void EndcapNode::send_time_sync_request() {
   dds_->sync_request->write(&req);
 }
 
+void EndcapNode::report_if_unsynced() {
+  TimeSyncCounters c;
+  {
+    std::lock_guard lock(mutex_);
+    if (sync_.estimator().synced()) return;
+    c = sync_.counters();
+  }
+  using ull = unsigned long long;
+  log("time sync: not synchronized after %u requests; replies accepted %llu, late or replayed %llu, implausible %llu "
+      "(round trip > limit %llu, host hold > limit %llu), conflicting %llu",
+      sync_sequence_, static_cast<ull>(c.accepted), static_cast<ull>(c.unknown_nonce), static_cast<ull>(c.implausible),
+      static_cast<ull>(c.implausible_round_trip), static_cast<ull>(c.implausible_hold), static_cast<ull>(c.conflicting));
+}
+
 void EndcapNode::on_time_sync_reply(Dds& d) {
   std::lock_guard guard(d.callback_mutex);
   if (d.closed || d.sync_reply == nullptr) return;  // stopping, or still starting (taken next time)

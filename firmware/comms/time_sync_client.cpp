@@ -6,20 +6,21 @@
 namespace tensegrity::fw::comms {
 namespace {
 
-// Offset and round trip of one exchange; false when it is implausible. Every
-// stamp is range-checked before it is subtracted.
-bool evaluate(const TimeSyncLimits& limits, std::int64_t t1, std::int64_t t2, std::int64_t t3, std::int64_t t4,
-              ClockSample& out) {
+enum class Plausibility : std::uint8_t { ok, bad_stamp, hold_too_long, round_trip_too_long };
+
+// Offset and round trip of one exchange, or why it is implausible. Every stamp
+// is range-checked before it is subtracted.
+Plausibility evaluate(const TimeSyncLimits& limits, std::int64_t t1, std::int64_t t2, std::int64_t t3,
+                      std::int64_t t4, ClockSample& out) {
   auto local_ok = [](std::int64_t t) { return t >= -kMaxWireTimeNs && t <= kMaxWireTimeNs; };
-  if (!valid_wire_time(t2) || !valid_wire_time(t3) || !local_ok(t1) || !local_ok(t4)) return false;
+  if (!valid_wire_time(t2) || !valid_wire_time(t3) || !local_ok(t1) || !local_ok(t4)) return Plausibility::bad_stamp;
   const std::int64_t hold = t3 - t2;
   const std::int64_t round_trip = (t4 - t1) - hold;
-  if (hold < 0 || hold > limits.max_host_hold_ns || t4 < t1 || round_trip < 0 ||
-      round_trip > limits.max_round_trip_ns) {
-    return false;
-  }
+  if (hold < 0 || t4 < t1 || round_trip < 0) return Plausibility::bad_stamp;
+  if (hold > limits.max_host_hold_ns) return Plausibility::hold_too_long;
+  if (round_trip > limits.max_round_trip_ns) return Plausibility::round_trip_too_long;
   out = ClockSample{(t2 - t1) / 2 + (t3 - t4) / 2, round_trip, t4};
-  return true;
+  return Plausibility::ok;
 }
 
 std::int64_t abs_diff(std::int64_t a, std::int64_t b) { return a > b ? a - b : b - a; }
@@ -66,8 +67,11 @@ TimeSyncVerdict TimeSyncClient::on_reply(std::uint64_t nonce, std::int64_t t2_ns
     return TimeSyncVerdict::unknown_nonce;
   }
   ClockSample sample;
-  if (!evaluate(limits_, p->t1_ns, t2_ns, t3_ns, t4_ns, sample)) {
+  const Plausibility plausibility = evaluate(limits_, p->t1_ns, t2_ns, t3_ns, t4_ns, sample);
+  if (plausibility != Plausibility::ok) {
     ++counters_.implausible;
+    if (plausibility == Plausibility::round_trip_too_long) ++counters_.implausible_round_trip;
+    if (plausibility == Plausibility::hold_too_long) ++counters_.implausible_hold;
     return TimeSyncVerdict::implausible;
   }
   if (p->answers++ == 0) {

@@ -44,6 +44,8 @@ struct TimeSyncCounters {
   std::uint64_t accepted = 0;
   std::uint64_t unknown_nonce = 0;
   std::uint64_t implausible = 0;
+  std::uint64_t implausible_round_trip = 0;  // of those: the round trip above max_round_trip
+  std::uint64_t implausible_hold = 0;        // the host held it above max_host_hold
   std::uint64_t conflicting = 0;
   std::uint64_t inconsistent = 0;
   std::uint64_t resyncs = 0;
