@@ -14,7 +14,6 @@
 #include "cli/stop_signals.hpp"
 #include "cli/view_options.hpp"
 #include "hil/dds_domain.hpp"
-#include "msgs/dds.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "sim/core_controller.hpp"
@@ -109,7 +108,6 @@ void run_hil_command(const HilArgs& args) {
   const auto page = open_view(args, options, sim::load_robot(options.robot.empty()
                                                                  ? sim::robot_path_for_policy(options.policy)
                                                                  : options.robot));
-  if (const std::string w = msgs::socket_buffer_warning(); !w.empty()) std::fprintf(stderr, "hil: note: %s\n", w.c_str());
   const hil::HilResult r = hil::run_hil(options);
   if (args.json) {
     std::printf("%s\n", hil::to_json(r).dump(2).c_str());

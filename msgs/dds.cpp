@@ -6,7 +6,6 @@
 
 #include <charconv>
 #include <cstdlib>
-#include <fstream>
 #include <mutex>
 
 #include "msgs/link_cut_transport.hpp"
@@ -30,20 +29,6 @@ int domain_id() {
   const char* env = std::getenv("TENSEGRITY_DOMAIN");
   if (env == nullptr || *env == '\0') return kDefaultDomain;
   return parse_domain_id(env);
-}
-
-std::string socket_buffer_warning() {
-  std::string capped;
-  for (const char* key : {"rmem_max", "wmem_max"}) {
-    std::ifstream in(std::string("/proc/sys/net/core/") + key);
-    long value = 0;
-    if (in >> value && value < kSocketBufferBytes) {
-      capped += (capped.empty() ? "" : ", ") + std::string("net.core.") + key + " = " + std::to_string(value);
-    }
-  }
-  if (capped.empty()) return {};
-  return "DDS socket buffers are capped at " + capped + " (want " + std::to_string(kSocketBufferBytes) +
-         "): on a loaded host discovery, acks and time sync get lost; scripts/setup.sh raises them (as root)";
 }
 
 void load_qos_profiles() {

@@ -67,11 +67,6 @@ inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyA
                                                      kEndcapHeartbeatTopic, kTimeSyncRequestTopic,
                                                      kTimeSyncReplyTopic};
 
-// The socket buffer size msgs/qos_profiles.xml asks for, and a warning naming the
-// sysctl when the kernel caps it lower (empty when it does not, or cannot be read).
-inline constexpr long kSocketBufferBytes = 4L * 1024 * 1024;
-std::string socket_buffer_warning();
-
 // Loads the QoS profiles once per process: TENSEGRITY_QOS_FILE if set, else the
 // copy compiled in. Throws DdsError when Fast DDS rejects the XML.
 void load_qos_profiles();

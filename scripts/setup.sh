@@ -4,22 +4,6 @@
 # Idempotent and silent when everything is already there.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-
-# DDS on one host (the HIL: 13 participants, 1,200 telemetry samples a second)
-# needs socket buffers above Linux's default 208 KiB cap; msgs/qos_profiles.xml
-# asks for 4 MiB and the kernel silently caps it (docs/dds.md "Socket buffers").
-want=4194304
-for key in rmem_max wmem_max; do
-  have=$(cat "/proc/sys/net/core/$key" 2>/dev/null || echo "$want")
-  if (( have < want )); then
-    if [[ $(id -u) -eq 0 ]] && sysctl -qw "net.core.$key=$want" 2>/dev/null; then
-      echo "setup: net.core.$key $have -> $want (DDS socket buffers)"
-    else
-      echo "setup: net.core.$key is $have; run 'sysctl -w net.core.$key=$want' as root for a reliable HIL" >&2
-    fi
-  fi
-done
-
 mapfile -t missing < <("$here/missing-packages.sh" "$here/debian-packages.txt")
 [[ ${#missing[@]} -eq 0 ]] && exit 0
 

@@ -93,7 +93,11 @@ class RealEndcaps : public ::testing::Test {
         // tripping sensor_timeout / drive_lost when the machine is busy (seen at
         // load average 50 with 1 kHz and 0.5-1 s).
         {"loop", {{"rate_hz", 250}, {"mode", "realtime"}}},
-        {"timeouts", {{"drive_heartbeat_s", 3.0}, {"load_cell_heartbeat_s", 3.0}, {"load_cell_sample_s", 2.0}}},
+        {"timeouts",
+         {{"drive_heartbeat_s", 3.0}, {"load_cell_heartbeat_s", 3.0}, {"load_cell_sample_s", 2.0},
+          // Seen in a fresh-clone CI run: a 20 ms position gap (the default) latched
+          // stale_position on one end cap.
+          {"drive_position_s", 2.0}, {"drive_consumer_heartbeat_s", 1.0}}},
     };
     const fs::path config_file = dir_ / ("endcap" + tag + ".json");
     std::ofstream(config_file) << config.dump(2);

@@ -7,6 +7,7 @@ slider moves time and the robot; the live page follows a HIL run (real time: see
 refuses every method but GET. Prints the replay's open time and frame rate and the
 live latency (measured here, not asserted: docs/view.md)."""
 import argparse
+import json
 import os
 import re
 import subprocess
@@ -102,12 +103,21 @@ def test_live(args, driver, tmp):
     port = free_port()
     hil_log = os.path.join(tmp, "hil.log")
     # Real time, not lockstep: a lockstep run holds both cores at SCHED_FIFO and RT
-    # throttling leaves the browser 5 % of them (its scripts time out). A generous
-    # barrier: twelve end caps booting beside a software-rendering browser.
+    # throttling leaves the browser 5 % of them (its scripts time out). The page opens
+    # once all 12 end caps play (--view-wait 0, then the view's own status): a page
+    # loading beside the run's DDS discovery left 4-9 end caps unsynchronized for
+    # 15-30 s in two CI runs (software WebGL takes what the SCHED_FIFO loops leave).
     with Process([args.tensegrity, "hil", "--mode", args.hil_mode, "--duration", "300", "--endcap", args.endcap,
-                  "--barrier-timeout", "30", "--view", "--view-port", str(port), "--view-wait", "120"], hil_log) as hil:
+                  "--barrier-timeout", "30", "--view", "--view-port", str(port), "--view-wait", "0"], hil_log) as hil:
         domain, _ = wait_for("hil --view's page", lambda: hil_domain(hil_log), 60)
         wait_for_server(port, hil)
+
+        def all_playing():
+            assert hil.proc.poll() is None, f"the HIL run ended early: {open(hil_log).read()[-2000:]}"
+            code, body = http(f"http://127.0.0.1:{port}/api/live/status")
+            ends = json.loads(body)["endcaps"] if code == 200 else []
+            return len(ends) == 12 and all(e["seen"] and e["state"] == "running" for e in ends)
+        wait_for("12 end caps playing", all_playing, 120, interval=0.5)
         driver.get(f"http://127.0.0.1:{port}/")
         def streaming():
             assert hil.proc.poll() is None, f"the HIL run ended early: {open(hil_log).read()[-2000:]}"
