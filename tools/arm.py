@@ -10,7 +10,9 @@ unfinished ones resume. Seeds run --jobs at a time under `nice`.
 
 Summary (OUT/arm.json, OUT/arm.csv, OUT/arm.png), at every --at budget:
 best team so far per seed, median and quartiles over seeds, seeds >= 28 m and
->= 32 m, the episode of each seed's first team >= 32 m, the generation mean
+>= 32 m, the episode of each seed's first team >= 28 m and >= 32 m (earliest
+over seeds, and the median over all seeds, counting a seed that never got there
+as later than the budget), the generation mean
 (last 5 generations before the budget), the infeasible share of the first 10
 generations.
 
@@ -106,11 +108,13 @@ def seed_metrics(curve, budget):
     if not rows:
         return None
     first32 = next((int(r["episodes"]) for r in curve if r["best_so_far_m"] >= TARGET_M), None)
+    first28 = next((int(r["episodes"]) for r in curve if r["best_so_far_m"] >= NEAR_M), None)
     early = curve[:10]
     return {
         "best_m": rows[-1]["best_so_far_m"],
         "generation_mean_m": statistics.fmean(r["mean_score_m"] for r in rows[-5:]),
         "first_episode_32m": first32 if first32 is not None and first32 <= budget else None,
+        "first_episode_28m": first28 if first28 is not None and first28 <= budget else None,
         "infeasible_first10": sum(r["infeasible"] for r in early) / max(1.0, sum(r["teams"] for r in early)),
         "episodes": int(rows[-1]["episodes"]),
     }
@@ -123,6 +127,15 @@ def quartiles(values):
     return q[0], statistics.median(values), q[2]
 
 
+def censored_median(episodes):
+    """Median episode of a first success over all seeds; a seed without one (None) counts
+    as later than the budget. None when the median itself is such a seed."""
+    if not episodes:
+        return None
+    med = statistics.median([float("inf") if e is None else e for e in episodes])
+    return None if med == float("inf") else med
+
+
 def summarise_budget(per_seed, budget):
     best = [m["best_m"] for m in per_seed.values()]
     q1, med, q3 = quartiles(best)
@@ -132,6 +145,10 @@ def summarise_budget(per_seed, budget):
             "max_m": max(best, default=None), "seeds_ge_28": sum(b >= NEAR_M for b in best),
             "seeds_ge_32": sum(b >= TARGET_M for b in best),
             "first_episode_32m": min(firsts, default=None),
+            "first_episode_28m": min((m["first_episode_28m"] for m in per_seed.values()
+                                      if m["first_episode_28m"] is not None), default=None),
+            "first_episode_28m_median": censored_median([m["first_episode_28m"] for m in per_seed.values()]),
+            "first_episode_32m_median": censored_median([m["first_episode_32m"] for m in per_seed.values()]),
             "generation_mean_median_m": statistics.median([m["generation_mean_m"] for m in per_seed.values()])
             if best else None,
             "infeasible_first10_mean": statistics.fmean([m["infeasible_first10"] for m in per_seed.values()])
@@ -162,7 +179,7 @@ def summarise_arm(out, args):
     (out / "arm.json").write_text(json.dumps(result, indent=2) + "\n")
     with open(out / "arm.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["budget", "seed", "episodes", "best_m", "generation_mean_m",
-                                          "first_episode_32m", "infeasible_first10"])
+                                          "first_episode_28m", "first_episode_32m", "infeasible_first10"])
         w.writeheader()
         w.writerows(rows)
     plot_arm(out, curves)
@@ -203,7 +220,8 @@ def compare(args):
             rows.append({k: v for k, v in at.items() if k != "per_seed"} | {"arm": arm["arm"]})
     (out / "compare.json").write_text(json.dumps(rows, indent=2) + "\n")
     fields = ["arm", "budget", "seeds", "median_m", "q1_m", "q3_m", "mean_m", "min_m", "max_m", "seeds_ge_28",
-              "seeds_ge_32", "first_episode_32m", "generation_mean_median_m", "infeasible_first10_mean"]
+              "seeds_ge_32", "first_episode_28m", "first_episode_28m_median", "first_episode_32m",
+              "first_episode_32m_median", "generation_mean_median_m", "infeasible_first10_mean"]
     with open(out / "compare.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -211,6 +229,7 @@ def compare(args):
     for r in rows:
         print(f"{r['arm']:<28} {r['budget']:>5} ep  n={r['seeds']:<2} median {r['median_m']:6.2f} "
               f"[{r['q1_m']:6.2f}, {r['q3_m']:6.2f}]  >=28: {r['seeds_ge_28']}  >=32: {r['seeds_ge_32']}  "
+              f"first28: {r['first_episode_28m']} (median {r['first_episode_28m_median'] or '>' + str(r['budget'])})  "
               f"first32: {r['first_episode_32m']}  gen mean {r['generation_mean_median_m']:.2f}")
     plot_compare(out, arms)
 
