@@ -36,6 +36,7 @@ struct HilArgs {
   std::string record;
   std::string endcap;
   double barrier_timeout_s = 2.0;
+  double speed = -1.0;  // not given: 1 for a lockstep run with --view, else no limit
   std::string provision = hil::to_string(hil::default_provision());
   std::string host_loss = "continue";
   int domain = -1;
@@ -57,6 +58,10 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.record_csv = a.record;
   o.endcap_binary = a.endcap;
   o.barrier_timeout_s = a.barrier_timeout_s;
+  if (a.speed >= 0.0 && o.mode != hil::StepperMode::lockstep) {
+    throw CommandError(2, "hil: --speed is for lockstep runs (a realtime run keeps to the wall clock)");
+  }
+  o.max_speed = a.speed >= 0.0 ? a.speed : (a.view && o.mode == hil::StepperMode::lockstep ? 1.0 : 0.0);
   o.keep_dir = a.keep;
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
   o.host_loss = a.host_loss;
@@ -133,6 +138,10 @@ void add_hil_command(CLI::App& app) {
   cmd->add_option("--endcap", args->endcap, "The endcap program (default: the one built with this tree, or $TENSEGRITY_ENDCAP)");
   cmd->add_option("--barrier-timeout", args->barrier_timeout_s, "Lockstep: seconds to wait for an end cap's targets")
       ->capture_default_str()->check(CLI::Range(0.01, 600.0));
+  cmd->add_option("--speed", args->speed,
+                  "Lockstep: physics at most this many times real time, 0 for as fast as the end caps answer "
+                  "(default: 0; 1 with --view, so that the page shows the run as it would happen)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--provision", args->provision,
                   "dds: upload and start over DDS as on the robot (`tensegrity upload`/`start`); "
                   "local: each end cap gets --policy FILE --start-on-boot, no DDS")

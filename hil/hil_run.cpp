@@ -196,6 +196,7 @@ StepperConfig stepper_config(const HilOptions& options, const RunParts& parts, c
   sc.first_answer_timeout_ns = std::max<std::int64_t>(sc.barrier_timeout_ns, 10'000'000'000);
   sc.phase_period_steps = static_cast<std::int64_t>(std::llround(parts.policy->period_s / parts.robot->time_step_s));
   sc.realtime_gate_on_arrival = parts.provisioner->needs_hold();
+  sc.max_speed = options.mode == StepperMode::lockstep ? options.max_speed : 0.0;
   return sc;
 }
 

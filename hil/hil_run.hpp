@@ -41,6 +41,7 @@ struct HilOptions {
   std::filesystem::path record_csv;  // empty: none
   std::filesystem::path endcap_binary;  // empty: default_endcap_binary()
   double barrier_timeout_s = 2.0;
+  double max_speed = 0.0;  // lockstep: physics at most this many times real time (0: no limit)
   double boot_timeout_s = 30.0;
   Provision provision = default_provision();
   std::string host_loss = "continue";  // the end caps' --host-loss (dds)

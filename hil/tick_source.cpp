@@ -2,6 +2,7 @@
 #include "hil/tick_source.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <utility>
 
@@ -53,6 +54,18 @@ std::int64_t TickSource::pace(std::int64_t step, std::int64_t spin_ns) {
   const std::int64_t late = clock_.now_ns() - deadline;
   lateness_.add(late);
   return late;
+}
+
+void TickSource::limit_speed(double speed) {
+  min_tick_ns_ = speed > 0.0 ? static_cast<std::int64_t>(std::llround(static_cast<double>(period_ns_) / speed)) : 0;
+  next_tick_ns_ = clock_.now_ns();
+}
+
+void TickSource::pace_lockstep() {
+  if (min_tick_ns_ == 0) return;
+  clock_.sleep_until(next_tick_ns_, 0);
+  check_stop();
+  next_tick_ns_ = std::max(next_tick_ns_ + min_tick_ns_, clock_.now_ns() - kSpeedCatchUpNs);
 }
 
 void TickSource::advance_period(bool skip_missed) {

@@ -71,6 +71,15 @@ class TickSource {
   LatenessSummary lateness() const { return lateness_.summary(); }
   std::int64_t origin_ns() const { return origin_ns_; }
 
+  // --- lockstep speed limit ---
+  // Physics at most `speed` times real time (0: no limit), from now on: watched
+  // live, a run flat out is fast-forward, and it leaves the viewer no CPU.
+  void limit_speed(double speed);
+  // Sleeps until the next tick may begin under the limit (at once without one).
+  // After a stall the run catches up at most kSpeedCatchUpNs, not in one burst.
+  void pace_lockstep();
+  static constexpr std::int64_t kSpeedCatchUpNs = 100'000'000;
+
   // --- between runs ---
   // Periods paced without counting lateness, the first ending at `first_ns`.
   void begin_periods(std::int64_t first_ns) { period_end_ns_ = first_ns; }
@@ -88,6 +97,8 @@ class TickSource {
   LatenessStats lateness_;
   std::int64_t origin_ns_ = 0;
   std::int64_t period_end_ns_ = 0;
+  std::int64_t min_tick_ns_ = 0;  // lockstep: 0, no speed limit
+  std::int64_t next_tick_ns_ = 0;
 };
 
 }  // namespace tensegrity::hil

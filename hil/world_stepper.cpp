@@ -199,7 +199,9 @@ void WorldStepper::run(double duration_s) {
 }
 
 void WorldStepper::run_lockstep(std::int64_t steps) {
+  source_.limit_speed(config_.max_speed);
   for (std::int64_t i = 0; i < steps; ++i) {
+    source_.pace_lockstep();
     apply_faults();
     roster_.await_restarted(source_.clock(), source_.stop_token(), config_.boot_timeout_ns, stats_.steps);
     lockstep_tick(true);

@@ -84,6 +84,9 @@ struct StepperConfig {
   // Lockstep: sleep this fraction of the end caps' usual answer time before
   // waiting on the socket (answer_nap.hpp); 0: wait on the socket at once.
   double answer_nap_fraction = 0.7;
+  // Lockstep: physics at most this many times real time (0: as fast as the end
+  // caps answer), like Gazebo's real-time factor or PX4's speed factor.
+  double max_speed = 0.0;
 };
 
 struct StepperStats {

@@ -151,6 +151,51 @@ TEST(HilTickSource, PeriodsBetweenRunsSkipOrCatchUpMissedOnes) {
   EXPECT_EQ(source.period_end_ns(), clock.now) << "lockstep: no burst of ticks to make up the stall";
 }
 
+TEST(HilTickSource, LockstepWithoutASpeedLimitNeverSleeps) {
+  FakeClock clock;
+  TickSource source(clock, kPeriodNs, {}, 0.0);
+  source.limit_speed(0.0);
+  for (int k = 0; k < 10; ++k) source.pace_lockstep();
+  EXPECT_EQ(clock.sleeps, 0);
+}
+
+TEST(HilTickSource, LockstepSpeedLimitKeepsPhysicsToTheFactor) {
+  for (const double speed : {1.0, 2.0, 0.5}) {
+    FakeClock clock;
+    TickSource source(clock, kPeriodNs, {}, 0.0);
+    source.limit_speed(speed);
+    const std::int64_t t0 = clock.now;
+    for (int k = 0; k < 1000; ++k) {
+      source.pace_lockstep();
+      clock.now += 100'000;  // the tick itself: 0.1 ms of work
+    }
+    // 1000 ticks begin (1000 - 1) tick periods apart and the last takes 0.1 ms.
+    const auto tick_ns = static_cast<std::int64_t>(static_cast<double>(kPeriodNs) / speed);
+    EXPECT_EQ(clock.now - t0, 999 * tick_ns + 100'000) << "speed " << speed;
+  }
+}
+
+TEST(HilTickSource, LockstepSpeedLimitCatchesUpAStallOnlyPartly) {
+  FakeClock clock;
+  TickSource source(clock, kPeriodNs, {}, 0.0);
+  source.limit_speed(1.0);
+  source.pace_lockstep();
+  clock.now += 1'000'000'000;  // a tick that took 1 s (a stalled end cap)
+  int at_once = 0;
+  for (int k = 0; k < 1000; ++k) {
+    const int sleeps = clock.sleeps;
+    const std::int64_t before = clock.now;
+    source.pace_lockstep();
+    if (clock.now == before && (clock.sleeps == sleeps + 1)) ++at_once;
+    clock.now += 1000;
+  }
+  // At most kSpeedCatchUpNs of physics without a wait (the last tick at the limit's
+  // pace included), not the whole second.
+  const auto catch_up_ticks = static_cast<int>(TickSource::kSpeedCatchUpNs / kPeriodNs);
+  EXPECT_GE(at_once, catch_up_ticks - 1);
+  EXPECT_LE(at_once, catch_up_ticks + 2);
+}
+
 TEST(HilTickSource, AStopEndsEveryWait) {
   FakeClock clock;
   std::stop_source stop;
