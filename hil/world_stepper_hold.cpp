@@ -105,14 +105,20 @@ void WorldStepper::serve_until(const std::function<bool()>& done, std::int64_t t
   }
 }
 
+// Once per period, as in the run (world_stepper_realtime.cpp): sleep to the
+// period's end, then serve everything the end caps sent since. Serving each
+// arrival at once woke this SCHED_FIFO thread up to twelve times a period and
+// left the end caps' DDS threads too little: a real-time run's DDS bring-up took
+// 2-5 s and its upload 200-650 ms, against 1.2-2.2 s and 40-110 ms served per
+// period (seven alternating runs each, docs/hil-performance.md).
 void WorldStepper::serve_frames_until(std::int64_t until_ns) {
-  while (source_.now_ns() < until_ns) {
+  source_.clock().sleep_until(until_ns, 0);
+  for (;;) {
     rx_.clear();
-    if (hub_.receive(rx_, until_ns) > 0) {
-      serve(rx_);
-      hub_.flush();
-    }
+    if (hub_.receive(rx_, 0) == 0) break;
+    serve(rx_);
   }
+  hub_.flush();
 }
 
 // One real-time period without physics: heartbeats and fault reactions of every
