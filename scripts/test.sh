@@ -16,6 +16,9 @@ cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" -j "$(nproc)"
 # No source file over 400 lines, no function over 80 (scripts/size-exceptions.txt).
 python3 scripts/check_size.py -p "build/$preset" --self-test
+# Which room may include which (scripts/layers.json: each room includes only the
+# rooms its target links; firmware/core the C++ standard library only).
+python3 scripts/check_layers.py --self-test
 ctest --preset "$preset"
 echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
 # Every decoder of outside input under libFuzzer: corpora and recorded crashes

@@ -7,13 +7,9 @@
 #include <string>
 
 #include "firmware/comms/policy_wire.hpp"
+#include "firmware/comms/start_grid.hpp"
 
 namespace tensegrity::fw::comms {
-
-// The lockstep start grid in loop periods (start_grid_ns = this x the period):
-// 200 ms at 1 kHz. A 50 ms grid failed (tables 1-2 ticks apart) when the 2-core
-// host ran other real-time work at load 30 and time-sync errors exceeded 25 ms.
-inline constexpr std::int64_t kLockstepStartGridPeriods = 200;
 
 enum class HostLossAction : std::uint8_t { continue_gait = 0, stop = 1 };
 const char* to_string(HostLossAction action);
