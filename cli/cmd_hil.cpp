@@ -4,6 +4,7 @@
 // cmd_bench_hil.cpp.
 #include <sys/resource.h>
 
+#include <cstddef>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -12,14 +13,18 @@
 #include "cli/commands.hpp"
 #include "cli/shipped_policy.hpp"
 #include "cli/stop_signals.hpp"
+#ifdef TENSEGRITY_CLI_VIEW
 #include "cli/view_options.hpp"
 #include "hil/dds_domain.hpp"
+#endif
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
 #include "sim/policy.hpp"
+#ifdef TENSEGRITY_CLI_VIEW
 #include "view/modes.hpp"
+#endif
 
 namespace tensegrity::cli {
 namespace {
@@ -45,8 +50,10 @@ struct HilArgs {
   bool keep = false;
   bool json = false;
   bool view = false;
+#ifdef TENSEGRITY_CLI_VIEW
   double view_wait_s = 60.0;
   ViewServerArgs view_server;
+#endif
 };
 
 hil::HilOptions make_options(const HilArgs& a) {
@@ -83,6 +90,7 @@ hil::HilOptions make_options(const HilArgs& a) {
   return o;
 }
 
+#ifdef TENSEGRITY_CLI_VIEW
 // `--view`: the live page of this run, served while it runs. The view needs the
 // run's DDS domain before the run leases it, so a free one is chosen here; another
 // run taking it in between fails this one with a clear "domain in use".
@@ -103,6 +111,10 @@ std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& 
   }
   return v;
 }
+#else
+// A build without DDS has no live view, and `hil` offers no --view.
+std::nullptr_t open_view(const HilArgs&, hil::HilOptions&, const sim::Robot&) { return nullptr; }
+#endif
 
 void run_hil_command(const HilArgs& args) {
   // Ctrl-C ends the run in order: the children are shut down, the temp dir removed.
@@ -161,12 +173,14 @@ void add_hil_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"drive", "spool", "seize"}));
   cmd->add_flag("--keep", args->keep, "Keep the run directory (configs, stores, logs)");
   cmd->add_flag("--json", args->json, "Print one JSON object");
+#ifdef TENSEGRITY_CLI_VIEW
   cmd->add_flag("--view", args->view, "Serve the live page of this run (tensegrity view --live on its domain)");
   cmd->add_option("--view-wait", args->view_wait_s, "--view: seconds to wait for a page before starting (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--view-port", args->view_server.port, "--view: HTTP port of the page")->capture_default_str()
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--view-bind", args->view_server.bind, "--view: address to listen on")->capture_default_str();
+#endif
   cmd->callback([args] { run_hil_command(*args); });
 }
 

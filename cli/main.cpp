@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_analyze_command(app);
   tensegrity::cli::add_bench_command(app);
   tensegrity::cli::add_evolve_command(app);
+#ifdef TENSEGRITY_CLI_DDS
   tensegrity::cli::add_upload_command(app);
   tensegrity::cli::add_start_command(app);
   tensegrity::cli::add_stop_command(app);
@@ -22,8 +23,11 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_clear_fault_command(app);
   tensegrity::cli::add_status_command(app);
   tensegrity::cli::add_record_command(app);
+#endif
   tensegrity::cli::add_hil_command(app);
+#ifdef TENSEGRITY_CLI_VIEW
   tensegrity::cli::add_view_command(app);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
