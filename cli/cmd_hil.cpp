@@ -122,7 +122,7 @@ void run_hil_command(const HilArgs& args) {
   hil::HilOptions options = make_options(args);
   options.stop = stop.token();
   // Before the run raises this thread's priority: the view's threads stay ordinary.
-  const auto page = open_view(args, options, sim::load_robot(options.robot.empty()
+  [[maybe_unused]] const auto page = open_view(args, options, sim::load_robot(options.robot.empty()
                                                                  ? sim::robot_path_for_policy(options.policy)
                                                                  : options.robot));
   const hil::HilResult r = hil::run_hil(options);

@@ -16,13 +16,13 @@
 #include "ground/status.hpp"
 #include "ground/upload.hpp"
 #include "hil/hil_error.hpp"
+#include "hil/loop_rate.hpp"
 
 namespace tensegrity::hil {
 
 namespace {
 
 constexpr std::int64_t kNsPerS = 1'000'000'000;
-constexpr std::int64_t kTickNs = 1'000'000;  // the end caps' loop period in the HIL (1 kHz)
 constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
 
 std::int64_t to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
@@ -152,7 +152,7 @@ std::int64_t DdsProvisioner::place_start(StartHandshake& handshake, std::string&
     const FrozenTick frozen = handshake.freeze(ground::Station::now_ns() + 10 * kNsPerS);
     how = "SYNC +" + std::to_string(config_.start_after_ticks) + " after the freeze (last tick answered in " +
           std::to_string((frozen.answered_ns - frozen.sent_ns) / 1000) + " us)";
-    return frozen.sent_ns + config_.start_after_ticks * kTickNs + (frozen.answered_ns - frozen.sent_ns) / 2;
+    return frozen.sent_ns + config_.start_after_ticks * endcap_period_ns(robot_) + (frozen.answered_ns - frozen.sent_ns) / 2;
   }
   char in[48];
   std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);

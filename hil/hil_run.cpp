@@ -13,6 +13,7 @@
 #include "hil/hil_error.hpp"
 #include "hil/process_launcher.hpp"
 #include "hil/provisioner.hpp"
+#include "hil/loop_rate.hpp"
 #include "hil/realtime_priority.hpp"
 #include "hil/start_handshake.hpp"
 #ifdef TENSEGRITY_HIL_DDS
@@ -176,6 +177,7 @@ LauncherConfig launcher_config(const HilOptions& options, const sim::Robot& robo
   for (int e = 0; e < robot.endcap_count(); ++e) lc.motors_per_endcap.push_back(static_cast<int>(robot.cables_of(e).size()));
   lc.hub_port = hub_port;
   lc.mode = options.mode;
+  lc.loop_rate_hz = endcap_loop_rate_hz(robot);
   // The end cap's default spool: 446464 counts/rev on a 10 mm radius, 7.1e6
   // counts per metre, 0.14 um per count: about 1/1400 of one tick's motor
   // travel at 0.2 m/s, so the counts quantisation is negligible.

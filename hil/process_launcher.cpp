@@ -21,6 +21,7 @@
 #include <sstream>
 #include <thread>
 
+#include "firmware/app/config.hpp"
 #include "hil/hil_error.hpp"
 
 namespace tensegrity::hil {
@@ -28,6 +29,35 @@ namespace tensegrity::hil {
 namespace fs = std::filesystem;
 
 namespace {
+
+// An end cap's config file, written with the end cap's own schema (firmware/app/config.hpp).
+fw::app::EndcapAppConfig endcap_config(const LauncherConfig& lc, int motors, std::uint16_t port,
+                                       const fs::path& store) {
+  fw::app::EndcapAppConfig c;
+  // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
+  c.bus = "udp:127.0.0.1:" + std::to_string(lc.hub_port) + ",bind=127.0.0.1:" + std::to_string(port) + ",batch";
+  c.motor_count = static_cast<std::uint32_t>(motors);
+  for (int m = 0; m < motors; ++m) c.drive_node_ids[static_cast<std::size_t>(m)] = kDriveNodeIds[static_cast<std::size_t>(m)];
+  c.load_cell_node_id = kLoadCellNodeId;
+  c.spool_radius_m = lc.spool.spool_radius_m;
+  c.counts_per_rev = lc.spool.counts_per_rev;
+  c.initial_rest_length_m = lc.spool.initial_rest_length_m;
+  c.limits = lc.limits;
+  c.storage_dir = store;
+  c.loop_rate_hz = lc.loop_rate_hz;
+  c.mode = lc.mode == StepperMode::realtime ? fw::app::LoopMode::realtime : fw::app::LoopMode::lockstep;
+  c.drive_heartbeat_timeout_s = 0.1;
+  c.load_cell_heartbeat_timeout_s = 0.1;
+  c.load_cell_sample_timeout_s = 0.02;
+  // Real time on a shared 2-core host: an end cap's loop (or the emulator, whose
+  // catch-up ticks then pass without frames) was seen to stall beyond the default
+  // 50 ms while twelve programs start, and its drives then quick-stop it at boot.
+  // Lockstep keeps the default: its end caps beat in SYNC time, which is device time.
+  if (lc.mode == StepperMode::realtime) c.drive_consumer_heartbeat_s = kRealtimeConsumerHeartbeatS;
+  c.start_on_boot = false;
+  c.stats_log_period_s = 10.0;
+  return c;
+}
 
 // The low end of the kernel's ephemeral range (net.ipv4.ip_local_port_range).
 int ephemeral_low() {
@@ -106,34 +136,7 @@ ProcessLauncher::ProcessLauncher(const LauncherConfig& config, Provisioner& prov
     s.log = d / "endcap.log";
     s.stats = d / "stats.json";
     const int motors = e < static_cast<int>(config_.motors_per_endcap.size()) ? config_.motors_per_endcap[e] : 2;
-    nlohmann::json drives = nlohmann::json::array();
-    for (int m = 0; m < motors; ++m) drives.push_back(kDriveNodeIds[m]);
-    const auto& l = config_.limits;
-    nlohmann::json timeouts = {{"drive_heartbeat_s", 0.1}, {"load_cell_heartbeat_s", 0.1}, {"load_cell_sample_s", 0.02}};
-    // Real time on a shared 2-core host: an end cap's loop (or the emulator, whose
-    // catch-up ticks then pass without frames) was seen to stall beyond the default
-    // 50 ms while twelve programs start, and its drives then quick-stop it at boot.
-    // Lockstep keeps the default: its end caps beat in SYNC time, which is device time.
-    if (config_.mode == StepperMode::realtime) timeouts["drive_consumer_heartbeat_s"] = kRealtimeConsumerHeartbeatS;
-    const nlohmann::json j = {
-        {"format", "tensegrity-endcap/1"},
-        // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
-        {"bus", "udp:127.0.0.1:" + std::to_string(config_.hub_port) + ",bind=127.0.0.1:" + std::to_string(s.port) +
-                    ",batch"},
-        {"nodes", {{"drives", drives}, {"load_cell", kLoadCellNodeId}}},
-        {"spool", {{"radius_m", config_.spool.spool_radius_m}, {"counts_per_rev", config_.spool.counts_per_rev}}},
-        {"limits",
-         {{"min_rest_length_m", l.min_rest_length_m}, {"max_rest_length_m", l.max_rest_length_m},
-          {"speed_m_per_s", l.speed_m_per_s}, {"cutoff_tension_n", l.cutoff_tension_n},
-          {"hard_limit_tension_n", l.hard_limit_tension_n}}},
-        {"initial_rest_length_m", config_.spool.initial_rest_length_m},
-        {"storage_dir", (d / "store").string()},
-        {"loop", {{"rate_hz", 1000}, {"mode", to_string(config_.mode)}}},
-        {"timeouts", timeouts},
-        {"start_on_boot", false},
-        {"stats_log_period_s", 10},
-    };
-    std::ofstream(s.config) << j.dump(2) << "\n";
+    std::ofstream(s.config) << fw::app::config_to_json_text(endcap_config(config_, motors, s.port, d / "store"));
   }
 }
 

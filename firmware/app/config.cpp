@@ -242,6 +242,44 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   return c;
 }
 
+std::string config_to_json_text(const EndcapAppConfig& c) {
+  json drives = json::array();
+  for (std::uint32_t m = 0; m < c.motor_count; ++m) drives.push_back(c.drive_node_ids[m]);
+  const core::MotorLimits& l = c.limits;
+  const char* abort_connection = c.drive_abort_connection == canopen::AbortConnectionOption::disable_voltage ? "disable_voltage"
+                                 : c.drive_abort_connection == canopen::AbortConnectionOption::fault_signal   ? "fault"
+                                                                                                            : "quick_stop";
+  const json doc = {
+      {"format", "tensegrity-endcap/1"},
+      {"bus", c.bus},
+      {"nodes",
+       {{"drives", drives},
+        {"load_cell", c.use_load_cell ? json(c.load_cell_node_id) : json(nullptr)},
+        {"endcap", c.endcap_node_id}}},
+      {"spool", {{"radius_m", c.spool_radius_m}, {"counts_per_rev", c.counts_per_rev}}},
+      {"limits",
+       {{"min_rest_length_m", l.min_rest_length_m},
+        {"max_rest_length_m", l.max_rest_length_m},
+        {"speed_m_per_s", l.speed_m_per_s},
+        {"cutoff_tension_n", l.cutoff_tension_n},
+        {"hard_limit_tension_n", l.hard_limit_tension_n}}},
+      {"initial_rest_length_m", c.initial_rest_length_m},
+      {"storage_dir", c.storage_dir.string()},
+      {"loop", {{"rate_hz", c.loop_rate_hz}, {"mode", to_string(c.mode)}}},
+      {"timeouts",
+       {{"drive_heartbeat_s", c.drive_heartbeat_timeout_s},
+        {"load_cell_heartbeat_s", c.load_cell_heartbeat_timeout_s},
+        {"load_cell_sample_s", c.load_cell_sample_timeout_s},
+        {"drive_position_s", c.drive_position_timeout_s},
+        {"endcap_heartbeat_s", c.endcap_heartbeat_s},
+        {"drive_consumer_heartbeat_s", c.drive_consumer_heartbeat_s}}},
+      {"drive_abort_connection", abort_connection},
+      {"start_on_boot", c.start_on_boot},
+      {"stats_log_period_s", c.stats_log_period_s},
+  };
+  return doc.dump(2) + "\n";
+}
+
 EndcapAppConfig load_config(const std::filesystem::path& path, int endcap_id) {
   std::ifstream in(path);
   if (!in) throw ConfigError(path.string() + ": cannot open the config file");

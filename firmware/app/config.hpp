@@ -68,6 +68,11 @@ struct EndcapAppConfig {
   SpoolGeometry spool() const { return SpoolGeometry{spool_radius_m, counts_per_rev, initial_rest_length_m}; }
 };
 
+// The one writer of the format, beside its one reader: every field, so that
+// parse_config(config_to_json_text(c), c.endcap_id) == c. The HIL's launcher
+// writes its end caps' files with it instead of spelling the fields itself.
+std::string config_to_json_text(const EndcapAppConfig& c);
+
 // `source` names the text in errors (the file path).
 EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source = "config");
 EndcapAppConfig load_config(const std::filesystem::path& path, int endcap_id);

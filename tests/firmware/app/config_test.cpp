@@ -140,6 +140,55 @@ TEST(EndcapConfig, SupervisionDefaultsAreDerivedFromTheLoop) {
   EXPECT_EQ(c.drive_abort_connection, canopen::AbortConnectionOption::disable_voltage);
 }
 
+// The writer and the reader are one schema: whatever a config holds comes back.
+void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
+  EXPECT_EQ(a.endcap_id, b.endcap_id);
+  EXPECT_EQ(a.bus, b.bus);
+  EXPECT_EQ(a.motor_count, b.motor_count);
+  EXPECT_EQ(a.drive_node_ids, b.drive_node_ids);
+  EXPECT_EQ(a.use_load_cell, b.use_load_cell);
+  if (a.use_load_cell) {
+    EXPECT_EQ(a.load_cell_node_id, b.load_cell_node_id);
+  }
+  EXPECT_EQ(a.endcap_node_id, b.endcap_node_id);
+  EXPECT_EQ(a.spool_radius_m, b.spool_radius_m);
+  EXPECT_EQ(a.counts_per_rev, b.counts_per_rev);
+  EXPECT_EQ(a.limits.min_rest_length_m, b.limits.min_rest_length_m);
+  EXPECT_EQ(a.limits.max_rest_length_m, b.limits.max_rest_length_m);
+  EXPECT_EQ(a.limits.speed_m_per_s, b.limits.speed_m_per_s);
+  EXPECT_EQ(a.limits.cutoff_tension_n, b.limits.cutoff_tension_n);
+  EXPECT_EQ(a.limits.hard_limit_tension_n, b.limits.hard_limit_tension_n);
+  EXPECT_EQ(a.initial_rest_length_m, b.initial_rest_length_m);
+  EXPECT_EQ(a.storage_dir, b.storage_dir);
+  EXPECT_EQ(a.loop_rate_hz, b.loop_rate_hz);
+  EXPECT_EQ(a.mode, b.mode);
+  EXPECT_EQ(a.drive_heartbeat_timeout_s, b.drive_heartbeat_timeout_s);
+  EXPECT_EQ(a.load_cell_heartbeat_timeout_s, b.load_cell_heartbeat_timeout_s);
+  EXPECT_EQ(a.load_cell_sample_timeout_s, b.load_cell_sample_timeout_s);
+  EXPECT_EQ(a.drive_position_timeout_s, b.drive_position_timeout_s);
+  EXPECT_EQ(a.endcap_heartbeat_s, b.endcap_heartbeat_s);
+  EXPECT_EQ(a.drive_consumer_heartbeat_s, b.drive_consumer_heartbeat_s);
+  EXPECT_EQ(a.drive_abort_connection, b.drive_abort_connection);
+  EXPECT_EQ(a.start_on_boot, b.start_on_boot);
+  EXPECT_EQ(a.stats_log_period_s, b.stats_log_period_s);
+}
+
+TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
+  json full = example();
+  full["nodes"] = {{"drives", {5}}, {"load_cell", nullptr}, {"endcap", 100}};
+  full["timeouts"] = {{"drive_heartbeat_s", 0.25}, {"load_cell_heartbeat_s", 0.3}, {"load_cell_sample_s", 0.05},
+                      {"drive_position_s", 0.04}, {"endcap_heartbeat_s", 0.02}, {"drive_consumer_heartbeat_s", 0.07}};
+  full["drive_abort_connection"] = "fault";
+  full["start_on_boot"] = true;
+  full["stats_log_period_s"] = 2.5;
+  for (const json& doc : {example(), full}) {
+    const EndcapAppConfig c = parse_config(doc.dump(), 7);
+    const std::string written = config_to_json_text(c);
+    expect_same(parse_config(written, 7), c);
+    EXPECT_EQ(config_to_json_text(parse_config(written, 7)), written) << "a fixed point";
+  }
+}
+
 TEST(EndcapConfig, SupervisionErrorsNameTheField) {
   const auto with = [](const char* key, const json& value) {
     json j = example();
