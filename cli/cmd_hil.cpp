@@ -68,6 +68,8 @@ hil::HilOptions make_options(const HilArgs& a) {
   if (a.speed >= 0.0 && o.mode != hil::StepperMode::lockstep) {
     throw CommandError(2, "hil: --speed is for lockstep runs (a realtime run keeps to the wall clock)");
   }
+  // A factor near 0 would sleep for days between ticks, deaf to Ctrl-C.
+  if (a.speed > 0.0 && a.speed < 0.01) throw CommandError(2, "hil: --speed must be 0 (no limit) or 0.01..1000");
   o.max_speed = a.speed >= 0.0 ? a.speed : (a.view && o.mode == hil::StepperMode::lockstep ? 1.0 : 0.0);
   o.keep_dir = a.keep;
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
