@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -22,6 +23,10 @@
 #include "cli/run_cpu.hpp"
 #include "cli/shipped_policy.hpp"
 #include "cli/stop_signals.hpp"
+#ifdef TENSEGRITY_CLI_DDS
+#include "cli/ground_cli.hpp"
+#include "msgs/security.hpp"
+#endif
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
@@ -43,6 +48,9 @@ struct BenchHilArgs {
   double probe_s = 10.0;
   std::string endcap;
   std::string provision = hil::to_string(hil::default_provision());
+  std::string keystore;
+  bool insecure = false;
+  bool secure = false;
   bool json = false;
 };
 
@@ -153,6 +161,13 @@ ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double dura
   o.duration_s = duration_s;
   o.mode = mode;
   o.provision = args.provision == "local" ? hil::Provision::local : hil::Provision::dds;
+#ifdef TENSEGRITY_CLI_DDS
+  // --keystore DIR or --secure: what DDS Security costs, beside an unsecured run.
+  const char* env = std::getenv("TENSEGRITY_KEYSTORE");
+  if (!args.insecure && (args.secure || !args.keystore.empty() || (env != nullptr && *env != '\0'))) {
+    o.dds_keystore = args.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(args.keystore);
+  }
+#endif
   const auto steps = static_cast<std::int64_t>(std::llround(duration_s / dt_s));
   RunSampler sampler(steps);
   sampler.attach(o);
@@ -167,6 +182,13 @@ double late_rate(const hil::StepperStats& s) {
   return s.steps > 0 ? static_cast<double>(s.late_steps) / static_cast<double>(s.steps) : 0.0;
 }
 
+// What the host link's bring-up cost: with DDS Security every pair of the 13
+// participants authenticates before discovery goes on.
+nlohmann::json link_json(const hil::LinkTiming& t) {
+  if (!t.dds) return nullptr;
+  return {{"dds_security", t.secured}, {"discovery_s", t.discovery_s}, {"upload_s", t.upload_s}};
+}
+
 nlohmann::json lockstep_json(const ModeResult& m, double in_process_m) {
   const hil::HilResult& r = m.result;
   const double speed_up = m.cpu["speed_up"].get<double>();
@@ -174,6 +196,7 @@ nlohmann::json lockstep_json(const ModeResult& m, double in_process_m) {
   const double ticks = static_cast<double>(r.stats.steps + r.stats.boot_ticks);
   const double steps = r.stats.steps > 0 ? static_cast<double>(r.stats.steps) : 1.0;
   return {{"run", m.cpu},
+          {"link", link_json(r.link)},
           {"emulator_sched_fifo", r.emulator_realtime_priority},
           {"speed_up", speed_up},
           {"target_speed_up", kTargetSpeedUp},
@@ -195,6 +218,7 @@ nlohmann::json realtime_json(const ModeResult& m) {
   for (const auto& e : r.endcaps) overruns += e.overruns;
   const double rate = late_rate(r.stats);
   return {{"run", m.cpu},
+          {"link", link_json(r.link)},
           {"emulator_sched_fifo", r.emulator_realtime_priority},
           {"steps", r.stats.steps},
           {"late_steps", r.stats.late_steps},
@@ -227,6 +251,13 @@ nlohmann::json platform_json(const hil::TimerProbeResult& p) {
           {"stalled_s", 1e-9 * static_cast<double>(l.stalled_ns)},
           {"lateness_p99_s", 1e-9 * static_cast<double>(l.p99_ns)},
           {"max_lateness_s", 1e-9 * static_cast<double>(l.max_ns)}};
+}
+
+void print_link(const nlohmann::json& link) {
+  if (link.is_null()) return;
+  std::printf("            DDS link %s: 12 end caps found in %.2f s, policy uploaded in %.1f ms\n",
+              link["dds_security"].get<bool>() ? "secured (DDS Security)" : "UNSECURED (--insecure)",
+              link["discovery_s"].get<double>(), 1e3 * link["upload_s"].get<double>());
 }
 
 void print_cpu(const nlohmann::json& c) {
@@ -282,6 +313,7 @@ void run_bench_hil(const BenchHilArgs& args) {
               l["physics_us_per_step"].get<double>(), l["hub_syscalls_per_tick"].get<double>());
   std::printf("            distance %.4f m vs in-process %.4f m (difference %+.4f m)\n", l["distance_m"].get<double>(),
               l["in_process_distance_m"].get<double>(), l["distance_difference_m"].get<double>());
+  print_link(l["link"]);
   const auto& r = j["realtime"];
   const auto& rc = r["run"];
   std::printf("  realtime  %lld steps, %lld late (%.4f%%; target < %.1f%%, ratio %.2f), worst %.3f ms late, end-cap overruns %llu\n",
@@ -295,6 +327,7 @@ void run_bench_hil(const BenchHilArgs& args) {
   std::printf("            end cap CPU %.2f%% of a core (mean), %.2f%% (max); emulator %.2f%% of a core\n",
               100.0 * rc["endcap_core_fraction_mean"].get<double>(), 100.0 * rc["endcap_core_fraction_max"].get<double>(),
               100.0 * rc["emulator_process_cpu_s"].get<double>() / rc["wall_s"].get<double>());
+  print_link(r["link"]);
   print_cpu(rc);
   if (const auto& p = j["platform"]; !p.is_null()) {
     std::printf("  platform  a bare 1 kHz pacing thread (%s), %lld steps before the runs: %lld late (%.4f%%) in %lld "
@@ -320,6 +353,10 @@ void add_bench_hil_command(CLI::App& bench) {
   cmd->add_option("--provision", args->provision, "dds or local (see `tensegrity hil --help`)")
       ->capture_default_str()->check(CLI::IsMember({"dds", "local"}));
   cmd->add_flag("--json", args->json, "Print one JSON object");
+#ifdef TENSEGRITY_CLI_DDS
+  add_security_options(*cmd, args->keystore, args->insecure);
+  cmd->add_flag("--secure", args->secure, "DDS Security with the default keystore (made if missing)");
+#endif
   cmd->callback([args] { run_bench_hil(*args); });
 }
 

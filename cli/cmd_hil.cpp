@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,11 @@
 #include "cli/commands.hpp"
 #include "cli/shipped_policy.hpp"
 #include "cli/stop_signals.hpp"
+#ifdef TENSEGRITY_CLI_DDS
+#include "cli/ground_cli.hpp"
+#include "ground/keystore.hpp"
+#include "msgs/security.hpp"
+#endif
 #ifdef TENSEGRITY_CLI_VIEW
 #include "cli/view_options.hpp"
 #include "hil/dds_domain.hpp"
@@ -45,6 +51,9 @@ struct HilArgs {
   std::string provision = hil::to_string(hil::default_provision());
   std::string host_loss = "continue";
   int domain = -1;
+  std::string keystore;
+  bool insecure = false;
+  bool secure = false;
   std::vector<int> disabled_cables;
   std::string cable_failure = "drive";
   bool keep = false;
@@ -75,6 +84,16 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
   o.host_loss = a.host_loss;
   o.dds_domain = a.domain;
+  // Secured with --keystore DIR or --secure (the default keystore); the HIL runs
+  // both ends, so it makes the keystore if there is none yet. Unsecured by default
+  // for now: docs/security.md says why.
+#ifdef TENSEGRITY_CLI_DDS
+  if (a.secure && a.insecure) throw CommandError(2, "hil: --secure and --insecure exclude each other");
+  const char* env = std::getenv("TENSEGRITY_KEYSTORE");
+  if (!a.insecure && (a.secure || !a.keystore.empty() || (env != nullptr && *env != '\0'))) {
+    o.dds_keystore = a.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(a.keystore);
+  }
+#endif
   const sim::Robot robot = sim::load_robot(a.robot.empty() ? sim::robot_path_for_policy(o.policy) : std::filesystem::path(a.robot));
   try {
     if (!a.scenario.empty()) o.scenario = hil::load_scenario(a.scenario, robot.endcap_count());
@@ -102,7 +121,12 @@ std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& 
   if (o.dds_domain < 0) o.dds_domain = hil::DomainLease(-1).domain();
   std::unique_ptr<view::LiveView> v;
   try {
-    v = std::make_unique<view::LiveView>(robot, o.dds_domain, to_server_options(args.view_server));
+    std::filesystem::path enclave;
+    if (!o.dds_keystore.empty()) {
+      ground::ensure_keystore(o.dds_keystore);
+      enclave = msgs::enclave_dir(o.dds_keystore, msgs::enclave_name(msgs::Role::listener));
+    }
+    v = std::make_unique<view::LiveView>(robot, o.dds_domain, to_server_options(args.view_server), enclave);
   } catch (const std::exception& e) {
     throw CommandError(2, std::string("hil --view: ") + e.what());
   }
@@ -164,6 +188,12 @@ void add_hil_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"continue", "stop"}));
   cmd->add_option("--domain", args->domain, "dds: DDS domain of this run (default: a free one of 215..232)")
       ->check(CLI::Range(0, 232));
+#ifdef TENSEGRITY_CLI_DDS
+  add_security_options(*cmd, args->keystore, args->insecure);
+  cmd->add_flag("--secure", args->secure,
+                "dds: DDS Security with the default keystore (TENSEGRITY_KEYSTORE, else "
+                "~/.local/share/tensegrity/keystore; made if missing)");
+#endif
   cmd->add_option("--disable-cable", args->disabled_cables,
                   "Cable (muscle) M fails from the start (the paper's Figure 13); repeatable. How: --cable-failure")
       ->check(CLI::NonNegativeNumber);

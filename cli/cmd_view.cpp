@@ -10,6 +10,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/episode_json.hpp"
+#include "cli/ground_cli.hpp"
 #include "cli/view_options.hpp"
 #include "msgs/dds.hpp"
 #include "view/csv_table.hpp"
@@ -27,6 +28,8 @@ struct ViewArgs {
   std::string evolve_dir;
   std::string robot;
   int domain = -1;
+  std::string keystore;
+  bool insecure = false;
   ViewServerArgs server;
 };
 
@@ -52,7 +55,8 @@ void run_view(const ViewArgs& a) {
       wait_for_signal();
     } else if (a.live) {
       const int domain = a.domain >= 0 ? a.domain : msgs::domain_id();
-      view::LiveView v(load_robot_arg(a.robot), domain, server);
+      view::LiveView v(load_robot_arg(a.robot), domain, server,
+                       tool_enclave(msgs::Role::listener, a.keystore, a.insecure));
       std::printf("view: live, DDS domain %d, at %s  (read-only; Ctrl-C to stop)\n", domain, v.url().c_str());
       std::fflush(stdout);
       wait_for_signal();
@@ -82,6 +86,7 @@ void add_view_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--domain", args->domain, "--live: DDS domain (default: TENSEGRITY_DOMAIN, else 42)")
       ->check(CLI::Range(0, 232));
+  add_security_options(*cmd, args->keystore, args->insecure);
   add_view_server_options(*cmd, args->server);
   cmd->callback([args] { run_view(*args); });
 }

@@ -32,6 +32,8 @@ void add_estop_command(CLI::App& app);
 void add_clear_fault_command(CLI::App& app);
 void add_status_command(CLI::App& app);
 void add_record_command(CLI::App& app);
+// `security init|check`: DDS Security keystores (ground/keystore.hpp).
+void add_security_command(CLI::App& app);
 // The HIL emulator (hil/): `hil`, and `bench hil` added by add_bench_command.
 void add_hil_command(CLI::App& app);
 void add_bench_hil_command(CLI::App& bench);

@@ -1,8 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "cli/ground_cli.hpp"
 
+#include <cstdio>
+#include <cstdlib>
+
 #include "cli/commands.hpp"
 #include "msgs/dds.hpp"
+#include "msgs/security.hpp"
 
 namespace tensegrity::cli {
 
@@ -14,6 +18,33 @@ void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_ti
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd.add_option("--endcaps", options.endcaps, "End caps addressed, e.g. 0-11 or 0,3,5-7")->capture_default_str();
+  add_security_options(cmd, options.keystore, options.insecure);
+}
+
+void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure) {
+  auto* k = cmd.add_option("--keystore", keystore,
+                           "DDS Security keystore (tensegrity security init): speak with its ground identity "
+                           "(default: TENSEGRITY_KEYSTORE if set, else unsecured)");
+  auto* i = cmd.add_flag("--insecure", insecure, "Unauthenticated, unencrypted DDS even if TENSEGRITY_KEYSTORE is set");
+  k->excludes(i);
+}
+
+std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure) {
+  if (insecure) return {};
+  const char* env = std::getenv("TENSEGRITY_KEYSTORE");
+  if (keystore.empty() && (env == nullptr || *env == '\0')) {
+    std::fprintf(stderr, "tensegrity: DDS link unsecured (no --keystore or TENSEGRITY_KEYSTORE; docs/security.md)\n");
+    return {};
+  }
+  const std::filesystem::path store = keystore.empty() ? msgs::default_keystore() : std::filesystem::path(keystore);
+  const std::filesystem::path dir = msgs::enclave_dir(store, msgs::enclave_name(role));
+  if (!std::filesystem::exists(dir)) {
+    throw CommandError(2, "no DDS Security keystore at " + store.string() +
+                              ": create one with `tensegrity security init " + store.string() +
+                              "` (and give each end cap its enclave), name another with --keystore, or pass "
+                              "--insecure to speak to end caps without security");
+  }
+  return dir;
 }
 
 std::uint16_t parse_endcap_set(const std::string& text) {
@@ -43,6 +74,7 @@ std::unique_ptr<ground::Station> make_station(const GroundOptions& options, bool
   s.domain = options.domain >= 0 ? options.domain : msgs::domain_id();
   s.name = "tensegrity-cli";
   s.publish_heartbeat = publish_heartbeat;
+  s.enclave_dir = tool_enclave(msgs::Role::ground, options.keystore, options.insecure);
   return std::make_unique<ground::Station>(s);
 }
 

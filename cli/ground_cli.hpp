@@ -6,10 +6,12 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "ground/station.hpp"
+#include "msgs/security.hpp"
 
 namespace tensegrity::cli {
 
@@ -17,7 +19,17 @@ struct GroundOptions {
   int domain = -1;  // -1: TENSEGRITY_DOMAIN or the default
   double timeout_s = 5.0;
   std::string endcaps = "0-11";
+  // DDS Security: the keystore whose ground enclave this tool speaks with (empty:
+  // msgs::default_keystore()); `insecure` speaks unauthenticated, explicitly.
+  std::string keystore;
+  bool insecure = false;
 };
+
+// The enclave of `role` (ground, or listener for read-only tools) in `keystore`, or
+// in TENSEGRITY_KEYSTORE's; empty (unsecured, said on stderr) when neither is given
+// or `insecure`. Throws CommandError(2) when the keystore named is missing.
+std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure);
+void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure);
 
 void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_timeout_s);
 // "0-11", "3", "0,2,5-7" -> mask; throws CommandError(2) naming the bad part.

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_clear_fault_command(app);
   tensegrity::cli::add_status_command(app);
   tensegrity::cli::add_record_command(app);
+  tensegrity::cli::add_security_command(app);
 #endif
   tensegrity::cli::add_hil_command(app);
 #ifdef TENSEGRITY_CLI_VIEW

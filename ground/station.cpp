@@ -97,7 +97,7 @@ std::int64_t Station::now_ns() {
 
 Station::Station(const StationOptions& options) : options_(options), dds_(std::make_unique<Dds>()) {
   Dds& d = *dds_;
-  d.participant = msgs::create_participant(options.domain, options.name);
+  d.participant = msgs::create_participant(options.domain, options.name, nullptr, options.enclave_dir);
   d.publisher = d.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   d.subscriber = d.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (d.publisher == nullptr || d.subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");

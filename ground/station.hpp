@@ -12,6 +12,7 @@
 #include <array>
 #include <condition_variable>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -41,6 +42,8 @@ struct StationOptions {
   bool publish_heartbeat = true;
   double heartbeat_rate_hz = 5.0;
   bool serve_time = true;
+  // DDS Security: the ground enclave of a keystore (msgs/security.hpp); empty: unsecured.
+  std::filesystem::path enclave_dir;
 };
 
 struct EndcapStatus {

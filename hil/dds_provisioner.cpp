@@ -12,11 +12,13 @@
 #include <limits>
 
 #include "ground/command.hpp"
+#include "ground/keystore.hpp"
 #include "ground/station.hpp"
 #include "ground/status.hpp"
 #include "ground/upload.hpp"
 #include "hil/hil_error.hpp"
 #include "hil/loop_rate.hpp"
+#include "msgs/security.hpp"
 
 namespace tensegrity::hil {
 
@@ -32,12 +34,6 @@ std::int64_t to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
 void normal_priority() {
   sched_param p{};
   pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
-}
-
-std::string list(const std::vector<int>& ids) {
-  std::string s;
-  for (int i : ids) s += (s.empty() ? "" : ", ") + std::to_string(i);
-  return s;
 }
 
 }  // namespace
@@ -60,18 +56,35 @@ DdsProvisioner::DdsProvisioner(const sim::Robot& robot, const sim::Policy& polic
   ground::StationOptions so;
   so.domain = lease_.domain();
   so.name = "tensegrity-hil";
+  if (!config_.keystore.empty()) {
+    try {
+      if (ground::ensure_keystore(config_.keystore)) {
+        std::fprintf(stderr, "hil: created DDS Security keystore %s\n", config_.keystore.c_str());
+      }
+    } catch (const std::exception& e) {
+      throw HilError(std::string("DDS Security keystore: ") + e.what());
+    }
+    so.enclave_dir = msgs::enclave_dir(config_.keystore, msgs::enclave_name(msgs::Role::ground));
+  }
+  station_options_ = so;
   station_ = std::make_unique<ground::Station>(so);
 }
 
 DdsProvisioner::~DdsProvisioner() { end_run(); }
 
 std::string DdsProvisioner::name() const {
-  return "dds (domain " + std::to_string(lease_.domain()) + ", upload + start command)";
+  return "dds (domain " + std::to_string(lease_.domain()) + (config_.keystore.empty() ? ", unsecured" : ", secured") +
+         ", upload + start command)";
 }
 
 std::vector<std::string> DdsProvisioner::endcap_arguments(int, bool restart) const {
   std::vector<std::string> args{"--domain", std::to_string(lease_.domain()), "--dds-cut-signals", "--host-loss",
                                 config_.host_loss};
+  if (config_.keystore.empty()) {
+    args.emplace_back("--insecure");
+  } else {
+    args.insert(args.end(), {"--keystore", config_.keystore.string()});
+  }
   // Lockstep: the stepper's gate lets a restarted end cap through on a period
   // boundary, and start on boot makes that tick table time 0 (see the header).
   if (restart && config_.mode == StepperMode::lockstep) args.emplace_back("--start-on-boot");
@@ -89,25 +102,6 @@ std::vector<std::string> DdsProvisioner::log() const {
 }
 
 // 1. Everyone on the link with a synchronized clock (a start needs one).
-void DdsProvisioner::await_endcaps(std::uint16_t mask, std::int64_t deadline_ns) {
-  if (station_->wait_for_endcaps(mask, true, deadline_ns)) return;
-  std::vector<int> missing, unsynced;
-  const auto status = station_->snapshot();
-  for (int e = 0; e < robot_.endcap_count(); ++e) {
-    if (!status[e].seen) {
-      missing.push_back(e);
-    } else if (!status[e].heartbeat.clock_synced()) {
-      unsynced.push_back(e);
-    }
-  }
-  char within[64];
-  std::snprintf(within, sizeof within, "DDS: within %.1f s", config_.discovery_timeout_s);
-  std::string why = within;
-  if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
-  if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
-  throw HilError(why + " (see their logs)");
-}
-
 // 2. The policy, as `tensegrity upload` sends it. Returns the slowest acknowledgement.
 double DdsProvisioner::upload_policy(const fw::comms::PolicyIdentity& identity, double& total_s) {
   const auto tables = ground::policy_messages(policy_, robot_, identity, ground::random_sequence_base());
@@ -217,13 +211,18 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
   }
   char line[512];
   std::snprintf(line, sizeof line,
-                "dds: %d end caps on domain %d in %.0f ms; policy %s v%u uploaded in %.1f ms (slowest ack %.1f ms); "
+                "dds: %d end caps on domain %d (%s) in %.0f ms; policy %s v%u uploaded in %.1f ms (slowest ack %.1f ms); "
                 "start at host time %.6f s (%s); time sync at the start: worst round trip %.3f ms; at the end of "
                 "the hold: worst offset %.3f ms, worst round trip %.3f ms",
-                n, lease_.domain(), static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(),
+                n, lease_.domain(), config_.keystore.empty() ? "UNSECURED, --insecure" : "secured, DDS Security",
+                static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(),
                 identity.policy_version, upload_s * 1e3, worst_ack_s * 1e3, static_cast<double>(start_ns) * 1e-9,
                 how.c_str(), settle_rt_ms, worst_offset_ms, worst_round_trip_ms);
   note(line);
+  {
+    std::lock_guard lock(mutex_);
+    timing_ = LinkTiming{true, !config_.keystore.empty(), static_cast<double>(t_found - t0) * 1e-9, upload_s};
+  }
   if (config_.mode == StepperMode::lockstep) {
     handshake.go_after_ticks(config_.start_after_ticks);
   } else {

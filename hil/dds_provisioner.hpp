@@ -26,6 +26,7 @@
 
 #include "firmware/comms/policy_wire.hpp"
 #include "firmware/comms/start_grid.hpp"
+#include "ground/station.hpp"
 #include "hil/dds_domain.hpp"
 #include "hil/provisioner.hpp"
 #include "hil/start_handshake.hpp"
@@ -33,19 +34,18 @@
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 
-namespace tensegrity::ground {
-class Station;
-}
-
 namespace tensegrity::hil {
 
 struct DdsProvisionerConfig {
   int domain = -1;                  // -1: lease a free one (DomainLease)
   std::string host_loss = "continue";  // the end caps' --host-loss
+  // DDS Security: the keystore the HIL's ground station and end caps take their
+  // enclaves from (created if missing). Empty: unsecured (`hil --insecure`).
+  std::filesystem::path keystore;
   StepperMode mode = StepperMode::lockstep;
   // Every end cap's heartbeat with a synchronized clock. Usually 1-6 s; a real-time
   // HIL on 2 cores (1.3 of them at SCHED_FIFO) took up to 14.4 s (docs/hil.md).
-  double discovery_timeout_s = 30.0;
+  double discovery_timeout_s = 45.0;
   double upload_timeout_s = 10.0;
   double command_timeout_s = 5.0;
   // Lockstep: physics step 0 is this many SYNCs after the freeze: a whole number of
@@ -74,6 +74,7 @@ class DdsProvisioner final : public Provisioner {
   ~DdsProvisioner() override;
 
   std::string name() const override;
+  LinkTiming link_timing() const override;
   std::vector<std::string> endcap_arguments(int endcap, bool restart) const override;
   bool needs_hold() const override { return true; }
   void provision(const ProcessLauncher&) override {}
@@ -90,6 +91,7 @@ class DdsProvisioner final : public Provisioner {
  private:
   // deliver()'s steps.
   void await_endcaps(std::uint16_t mask, std::int64_t deadline_ns);
+  bool wait_or_rejoin(std::uint16_t mask, std::int64_t deadline_ns);
   double upload_policy(const fw::comms::PolicyIdentity& identity, double& total_s);
   void clear_faults_or_fail(std::uint16_t mask);
   std::int64_t place_start(StartHandshake& handshake, std::string& how);
@@ -109,11 +111,13 @@ class DdsProvisioner final : public Provisioner {
   std::string policy_id_;
   DdsProvisionerConfig config_;
   DomainLease lease_;
+  ground::StationOptions station_options_;
   std::unique_ptr<ground::Station> station_;
   std::int64_t start_host_ns_ = 0;  // the run's start (host time of table time 0)
 
   mutable std::mutex mutex_;
   std::vector<std::string> log_;
+  LinkTiming timing_;  // under mutex_
   std::vector<std::int64_t> restarted_at_ns_;  // per end cap: host time of a restart not yet started (0: none)
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;

@@ -91,6 +91,7 @@ std::unique_ptr<Provisioner> make_provisioner(const HilOptions& options, const s
   DdsProvisionerConfig c;
   c.domain = options.dds_domain;
   c.host_loss = options.host_loss;
+  c.keystore = options.dds_keystore;
   c.mode = options.mode;
   c.discovery_timeout_s = options.dds_discovery_timeout_s;
   return std::make_unique<DdsProvisioner>(robot, policy, options.policy, c);
@@ -284,6 +285,7 @@ void collect(const HilOptions& options, RunParts& parts, HilResult& result) {
   if (parts.provisioner) {
     if (parts.running) parts.provisioner->end_run();
     for (const auto& line : parts.provisioner->log()) result.log.push_back(line);
+    result.link = parts.provisioner->link_timing();
   }
   if (parts.stepper) {
     result.distance_m = parts.stepper->distance_m();

@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "hil/provisioner.hpp"
 #include "hil/scenario.hpp"
 #include "hil/world_stepper.hpp"
 
@@ -46,9 +47,14 @@ struct HilOptions {
   Provision provision = default_provision();
   std::string host_loss = "continue";  // the end caps' --host-loss (dds)
   int dds_domain = -1;                 // -1: a free one of the HIL's range (dds_domain.hpp)
+  // dds: DDS Security keystore (created if missing); empty: unsecured (--insecure).
+  std::filesystem::path dds_keystore;
   double hold_timeout_s = 60.0;        // dds: gate open to physics step 0
   bool keep_dir = false;
-  double dds_discovery_timeout_s = 30.0;  // dds: every end cap on the link, clock synchronized
+  // dds: every end cap on the link, clock synchronized. Secured discovery (each pair
+  // of 13 participants authenticates first) took 7-22 s lockstep, 24 s real time
+  // here; below hold_timeout_s, so that a missing end cap is named.
+  double dds_discovery_timeout_s = 45.0;
   std::vector<int> never_start;  // tests
   std::map<int, std::vector<std::string>> endcap_extra_args;  // tests: more arguments for an end cap
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).
@@ -92,6 +98,7 @@ struct HilResult {
   StepperStats stats;
   std::vector<EndcapSummary> endcaps;
   std::vector<std::string> log;
+  LinkTiming link;  // how the host link came up (dds)
   double wall_s = 0.0;
   std::string provisioner;
   double max_phase_offset_s = 0.0;  // over the end caps playing at the end

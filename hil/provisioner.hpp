@@ -21,6 +21,15 @@ namespace tensegrity::hil {
 class ProcessLauncher;
 class StartHandshake;
 
+// How the host link came up (the DDS provisioner's; bench hil reports what
+// DDS Security costs from it).
+struct LinkTiming {
+  bool dds = false;
+  bool secured = false;      // DDS Security (a keystore's enclaves)
+  double discovery_s = 0.0;  // every end cap's heartbeat with a synchronized clock
+  double upload_s = 0.0;     // the policy upload, first send to the last acknowledgement
+};
+
 class Provisioner {
  public:
   virtual ~Provisioner() = default;
@@ -50,6 +59,7 @@ class Provisioner {
   virtual void on_restart(int) {}
   // What the provisioner did, one line each, for the run's log.
   virtual std::vector<std::string> log() const { return {}; }
+  virtual LinkTiming link_timing() const { return {}; }
 };
 
 class LocalProvisioner final : public Provisioner {

@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "msgs/link_cut_transport.hpp"
+#include "msgs/security.hpp"
 
 namespace tensegrity::msgs {
 
@@ -49,7 +50,8 @@ void load_qos_profiles() {
   if (!error.empty()) throw DdsError(error);
 }
 
-dds::DomainParticipant* create_participant(int domain, const std::string& name, const std::atomic<bool>* link_cut) {
+dds::DomainParticipant* create_participant(int domain, const std::string& name, const std::atomic<bool>* link_cut,
+                                           const std::filesystem::path& enclave_dir) {
   load_qos_profiles();
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos qos;
@@ -57,12 +59,16 @@ dds::DomainParticipant* create_participant(int domain, const std::string& name, 
     throw DdsError(std::string("QoS profile '") + kParticipantProfile + "' not found");
   }
   qos.name(name);
+  if (!enclave_dir.empty()) apply_security(qos, enclave_files(enclave_dir));
   if (link_cut != nullptr) {
     for (auto& transport : qos.transport().user_transports) transport = make_link_cut_transport(transport, link_cut);
   }
   dds::DomainParticipant* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain), qos);
   if (participant == nullptr) {
-    throw DdsError("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain));
+    throw DdsError("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain) +
+                   (enclave_dir.empty() ? std::string()
+                                        : " with enclave " + enclave_dir.string() +
+                                              " (Fast DDS refused its certificate, key or signed documents)"));
   }
   return participant;
 }

@@ -15,6 +15,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -46,21 +47,26 @@ inline constexpr const char* kProfileTimeSync = "time_sync";
 inline constexpr const char* kProfileFreshCommands = "fresh_commands";
 inline constexpr const char* kParticipantProfile = "tensegrity_participant";
 
+// Which side writes a topic: the DDS Security permissions are made from this column
+// (msgs/security.hpp), so only the ground station's identity may give orders.
+enum class Writer : std::uint8_t { ground, endcap };
+
 struct TopicSpec {
   const char* name;     // ROS 2 style: "rt/" + ROS topic name
   const char* type;     // registered type name (ROS 2: pkg::msg::dds_::Type_)
   const char* profile;  // writer and reader profile of this topic
+  Writer writer;
 };
 
-inline constexpr TopicSpec kPolicyTableTopic{"rt/tensegrity/policy_table", "tensegrity_msgs::msg::dds_::PolicyTable_", kProfileDurable};
-inline constexpr TopicSpec kPolicyAckTopic{"rt/tensegrity/policy_ack", "tensegrity_msgs::msg::dds_::PolicyAck_", kProfileDurable};
-inline constexpr TopicSpec kCommandTopic{"rt/tensegrity/command", "tensegrity_msgs::msg::dds_::Command_", kProfileDurable};
-inline constexpr TopicSpec kCommandAckTopic{"rt/tensegrity/command_ack", "tensegrity_msgs::msg::dds_::CommandAck_", kProfileDurable};
-inline constexpr TopicSpec kTelemetryTopic{"rt/tensegrity/telemetry", "tensegrity_msgs::msg::dds_::Telemetry_", kProfileStream};
-inline constexpr TopicSpec kHostHeartbeatTopic{"rt/tensegrity/host_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream};
-inline constexpr TopicSpec kEndcapHeartbeatTopic{"rt/tensegrity/endcap_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream};
-inline constexpr TopicSpec kTimeSyncRequestTopic{"rt/tensegrity/time_sync_request", "tensegrity_msgs::msg::dds_::TimeSyncRequest_", kProfileTimeSync};
-inline constexpr TopicSpec kTimeSyncReplyTopic{"rt/tensegrity/time_sync_reply", "tensegrity_msgs::msg::dds_::TimeSyncReply_", kProfileTimeSync};
+inline constexpr TopicSpec kPolicyTableTopic{"rt/tensegrity/policy_table", "tensegrity_msgs::msg::dds_::PolicyTable_", kProfileDurable, Writer::ground};
+inline constexpr TopicSpec kPolicyAckTopic{"rt/tensegrity/policy_ack", "tensegrity_msgs::msg::dds_::PolicyAck_", kProfileDurable, Writer::endcap};
+inline constexpr TopicSpec kCommandTopic{"rt/tensegrity/command", "tensegrity_msgs::msg::dds_::Command_", kProfileDurable, Writer::ground};
+inline constexpr TopicSpec kCommandAckTopic{"rt/tensegrity/command_ack", "tensegrity_msgs::msg::dds_::CommandAck_", kProfileDurable, Writer::endcap};
+inline constexpr TopicSpec kTelemetryTopic{"rt/tensegrity/telemetry", "tensegrity_msgs::msg::dds_::Telemetry_", kProfileStream, Writer::endcap};
+inline constexpr TopicSpec kHostHeartbeatTopic{"rt/tensegrity/host_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream, Writer::ground};
+inline constexpr TopicSpec kEndcapHeartbeatTopic{"rt/tensegrity/endcap_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream, Writer::endcap};
+inline constexpr TopicSpec kTimeSyncRequestTopic{"rt/tensegrity/time_sync_request", "tensegrity_msgs::msg::dds_::TimeSyncRequest_", kProfileTimeSync, Writer::endcap};
+inline constexpr TopicSpec kTimeSyncReplyTopic{"rt/tensegrity/time_sync_reply", "tensegrity_msgs::msg::dds_::TimeSyncReply_", kProfileTimeSync, Writer::ground};
 
 inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyAckTopic, kCommandTopic,
                                                      kCommandAckTopic, kTelemetryTopic, kHostHeartbeatTopic,
@@ -72,11 +78,15 @@ inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyA
 void load_qos_profiles();
 
 // A participant on `domain` with the UDP-only profile; throws DdsError on failure.
+// With `enclave_dir` (a keystore's enclave folder, msgs/security.hpp) the DDS
+// Security plugins authenticate it and enforce the enclave's permissions; empty:
+// an unsecured participant, which a secured one never talks to.
 // Delete with delete_participant (deletes its entities first). With `link_cut`,
 // its transport drops every datagram in and out while *link_cut is true (fault
 // injection: msgs/link_cut_transport.hpp); the flag must outlive the participant.
 eprosima::fastdds::dds::DomainParticipant* create_participant(int domain, const std::string& name,
-                                                              const std::atomic<bool>* link_cut = nullptr);
+                                                              const std::atomic<bool>* link_cut = nullptr,
+                                                              const std::filesystem::path& enclave_dir = {});
 void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
 
 // Registers `type` (once per participant) and creates the topic of `spec`.

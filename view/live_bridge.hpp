@@ -11,6 +11,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -35,6 +36,8 @@ struct LiveOptions {
   // more than a software-rendering page parses beside its drawing: its queue grew
   // to seconds (median 367 ms, 95 % 2.5 s from sample to page, measured).
   double frame_rate_hz = 50.0;
+  // DDS Security: the listener enclave of a keystore (read-only permissions); empty: unsecured.
+  std::filesystem::path enclave_dir;
 };
 
 class LiveBridge {

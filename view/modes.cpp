@@ -31,10 +31,12 @@ ReplayView::ReplayView(const std::filesystem::path& csv, const sim::Robot& robot
   server_.start();
 }
 
-LiveView::LiveView(const sim::Robot& robot, int domain, const ServerOptions& server)
+LiveView::LiveView(const sim::Robot& robot, int domain, const ServerOptions& server,
+                   const std::filesystem::path& enclave_dir)
     : robot_(robot), robot_json_(robot_json(robot)), server_(server) {
   LiveOptions options;
   options.domain = domain;
+  options.enclave_dir = enclave_dir;
   bridge_ = std::make_unique<LiveBridge>(robot_, options, hub_);
   const std::string mode = mode_json("live", "live, DDS domain " + std::to_string(domain));
   server_.json("/api/mode", [mode] { return mode; });

@@ -35,7 +35,9 @@ class ReplayView {
 
 class LiveView {
  public:
-  LiveView(const sim::Robot& robot, int domain, const ServerOptions& server);
+  // `enclave_dir`: DDS Security enclave (a keystore's listener); empty: unsecured.
+  LiveView(const sim::Robot& robot, int domain, const ServerOptions& server,
+           const std::filesystem::path& enclave_dir = {});
   ~LiveView();
   std::string url() const { return server_.url(); }
   // True once a page is watching; false after `timeout_s`.

@@ -156,7 +156,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   }
   const Reader top(doc, source, "");
   top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
-            "drive_abort_connection", "start_on_boot", "stats_log_period_s"});
+            "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore"});
   if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
 
   EndcapAppConfig c;
@@ -239,6 +239,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   parse_abort_connection(top, c);
   c.start_on_boot = top.boolean("start_on_boot", false);
   c.stats_log_period_s = top.positive("stats_log_period_s", c.stats_log_period_s);
+  if (top.has("dds_keystore")) c.dds_keystore = top.string("dds_keystore");
   return c;
 }
 
@@ -249,7 +250,7 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
   const char* abort_connection = c.drive_abort_connection == canopen::AbortConnectionOption::disable_voltage ? "disable_voltage"
                                  : c.drive_abort_connection == canopen::AbortConnectionOption::fault_signal   ? "fault"
                                                                                                             : "quick_stop";
-  const json doc = {
+  json doc = {
       {"format", "tensegrity-endcap/1"},
       {"bus", c.bus},
       {"nodes",
@@ -277,6 +278,7 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
       {"start_on_boot", c.start_on_boot},
       {"stats_log_period_s", c.stats_log_period_s},
   };
+  if (!c.dds_keystore.empty()) doc["dds_keystore"] = c.dds_keystore.string();
   return doc.dump(2) + "\n";
 }
 

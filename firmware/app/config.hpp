@@ -63,6 +63,10 @@ struct EndcapAppConfig {
   canopen::AbortConnectionOption drive_abort_connection = canopen::AbortConnectionOption::quick_stop;
   bool start_on_boot = false;
   double stats_log_period_s = 10.0;
+  // DDS Security keystore (tensegrity security init; this end cap uses its enclave
+  // enclaves/tensegrity/endcap_NN). Empty: not in the file, so `endcap` needs
+  // --keystore or an explicit --insecure (docs/security.md).
+  std::filesystem::path dds_keystore;
 
   std::int64_t period_ns() const;
   SpoolGeometry spool() const { return SpoolGeometry{spool_radius_m, counts_per_rev, initial_rest_length_m}; }

@@ -14,6 +14,7 @@
 #ifdef TENSEGRITY_ENDCAP_DDS
 #include "firmware/comms/endcap_node.hpp"
 #include "msgs/dds.hpp"
+#include "msgs/security.hpp"
 #endif
 
 namespace tensegrity::fw::app {
@@ -96,6 +97,25 @@ void Endcap::restore_or_store_table() {
   }
 }
 
+#ifdef TENSEGRITY_ENDCAP_DDS
+// An end cap that obeys whoever is on the Wi-Fi must be a choice, never an
+// accident: without a keystore the DDS link needs an explicit --insecure.
+std::filesystem::path Endcap::enclave_dir() const {
+  if (options_.insecure) {
+    log_line("DDS security OFF (--insecure): any participant on domain may command this end cap");
+    return {};
+  }
+  const std::filesystem::path keystore = !options_.keystore.empty() ? options_.keystore : config_.dds_keystore;
+  if (keystore.empty()) {
+    throw EndcapError("no DDS Security keystore: set \"dds_keystore\" in " + options_.config_path.string() +
+                      " or pass --keystore DIR (tensegrity security init), or run without security with --insecure");
+  }
+  const std::filesystem::path dir = msgs::enclave_dir(keystore, msgs::enclave_name(msgs::Role::endcap, options_.id));
+  log_line("DDS security: enclave %s", dir.c_str());
+  return dir;
+}
+#endif
+
 void Endcap::start_host_link() {
 #ifdef TENSEGRITY_ENDCAP_DDS
   if (options_.no_dds) return;
@@ -111,6 +131,7 @@ void Endcap::start_host_link() {
       node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
     }
     node_config.link_cut = options_.link_cut;
+    node_config.enclave_dir = enclave_dir();
     node_config.loop_progress = &loop_progress_;
     auto node = std::make_unique<comms::EndcapNode>(node_config, clock_, store_.get());
     node->start();

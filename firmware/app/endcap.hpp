@@ -40,6 +40,8 @@ struct EndcapOptions {
   bool no_dds = false;
   std::string host_loss = "continue";
   int domain = -1;  // -1: TENSEGRITY_DOMAIN or the default
+  std::filesystem::path keystore;  // --keystore: overrides the config's dds_keystore
+  bool insecure = false;           // --insecure: DDS without security, explicitly
   const std::atomic<bool>* link_cut = nullptr;  // --dds-cut-signals
   const std::atomic<bool>* hang_loop = nullptr;  // --hang-loop-signal (HIL tests only)
 };
@@ -70,6 +72,7 @@ class Endcap {
  private:
   void restore_or_store_table();
   void start_host_link();
+  std::filesystem::path enclave_dir() const;
   void housekeeping();
 
   EndcapOptions options_;

@@ -121,6 +121,12 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"continue", "stop"}))
       ->capture_default_str();
   cli.add_option("--domain", o.domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
+  std::string keystore;
+  auto* keystore_opt = cli.add_option("--keystore", keystore,
+                                      "DDS Security keystore (overrides the config's dds_keystore); this end cap uses "
+                                      "its enclave enclaves/tensegrity/endcap_NN");
+  cli.add_flag("--insecure", o.insecure, "DDS without security: any participant on the domain may command this end cap")
+      ->excludes(keystore_opt);
   cli.add_flag("--dds-cut-signals", cut_signals,
                "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
   cli.add_flag("--hang-loop-signal", hang_signal,
@@ -137,6 +143,7 @@ int main(int argc, char** argv) {
     o.hang_loop = &g_hang_loop;
   }
   o.config_path = config_path;
+  o.keystore = keystore;
   o.policy_path = policy_path;
 
   app::Endcap endcap(o);

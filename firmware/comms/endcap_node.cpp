@@ -53,7 +53,8 @@ EndcapNode::~EndcapNode() { stop(); }
 void EndcapNode::start() {
   if (running_.load()) return;
   auto d = std::make_unique<Dds>();
-  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), config_.link_cut);
+  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), config_.link_cut,
+                                             config_.enclave_dir);
   d->publisher = d->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   d->subscriber = d->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (d->publisher == nullptr || d->subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
@@ -73,7 +74,8 @@ void EndcapNode::start() {
   dds::DataReader* sync_reply =
       d->reader(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new m::TimeSyncReply_PubSubType()),
                 listener([this, raw] { on_time_sync_reply(*raw); }, msgs::kTimeSyncReplyTopic.name));
-  const msgs::TopicSpec fresh_commands{msgs::kCommandTopic.name, msgs::kCommandTopic.type, msgs::kProfileFreshCommands};
+  const msgs::TopicSpec fresh_commands{msgs::kCommandTopic.name, msgs::kCommandTopic.type, msgs::kProfileFreshCommands,
+                                       msgs::kCommandTopic.writer};
   dds::DataReader* command = d->reader(fresh_commands, dds::TypeSupport(new m::Command_PubSubType()),
                                        listener([this, raw] { on_commands(*raw); }, msgs::kCommandTopic.name));
   {

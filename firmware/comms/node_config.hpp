@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 
 #include "firmware/comms/policy_wire.hpp"
@@ -19,6 +20,8 @@ HostLossAction parse_host_loss_action(const std::string& text);
 struct EndcapNodeConfig {
   int endcap_id = 0;
   int domain = 42;
+  // DDS Security: this end cap's enclave folder (msgs/security.hpp). Empty: unsecured.
+  std::filesystem::path enclave_dir;
   PolicyExpectations expect{};  // endcap_id is overwritten with `endcap_id`
   double telemetry_rate_hz = 100.0;
   double heartbeat_rate_hz = 5.0;

@@ -56,6 +56,9 @@ class RealEndcaps : public ::testing::Test {
     // before the first end cap has bound its ports can return the same one
     // ("Address already in use", seen once in 17 runs under load).
     ports_ = hil::free_udp_ports(2 * kEndcapCount);
+    // Unsecured, explicitly: twelve separate end-cap processes with DDS Security
+    // leave one unauthenticated now and then (docs/security.md); the secured link
+    // is tested in security_dds_test.cpp and hil_dds_test.cpp.
   }
   void TearDown() override {
     // End caps first: a device simulator gone first would fault them (noise in the logs).
@@ -105,14 +108,21 @@ class RealEndcaps : public ::testing::Test {
         std::vector<std::string>{ENDCAP_DEVICE_SIM, std::to_string(device_port), std::to_string(endcap_port), "300"},
         dir_ / ("devices" + tag + ".out"), dir_ / ("devices" + tag + ".err")));
     endcaps_.push_back(std::make_unique<Subprocess>(
-        std::vector<std::string>{ENDCAP_BINARY, "--id", tag, "--config", config_file.string()},
+        std::vector<std::string>{ENDCAP_BINARY, "--id", tag, "--config", config_file.string(), "--insecure"},
         dir_ / ("endcap" + tag + ".out"), dir_ / ("endcap" + tag + ".err")));
+  }
+
+  std::string seen_text() const {
+    std::string s;
+    const auto status = observer_->snapshot();
+    for (int e = 0; e < kEndcapCount; ++e) s += status[static_cast<std::size_t>(e)].seen ? "+" : "-";
+    return s;
   }
 
   // Runs `tensegrity ARGS... --domain D` to the end: exit code, stdout in `out`.
   int tensegrity(std::vector<std::string> args, std::string& out, std::string* err = nullptr) {
     args.insert(args.begin(), TENSEGRITY_CLI);
-    args.insert(args.end(), {"--domain", std::to_string(kDomain)});
+    args.insert(args.end(), {"--domain", std::to_string(kDomain), "--insecure"});
     const fs::path o = dir_ / "cli.out", e = dir_ / "cli.err";
     Subprocess cli(args, o, e);
     const int rc = cli.wait_exit(std::chrono::seconds(60));
@@ -149,8 +159,10 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   o.name = "e2e_observer";
   o.publish_heartbeat = false;  // an observer: the CLI is the host
   observer_ = std::make_unique<Station>(o);
-  ASSERT_TRUE(observer_->wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + 20'000'000'000))
-      << "not every end cap's DDS node came up";
+  const std::int64_t t0 = Station::now_ns();
+  ASSERT_TRUE(observer_->wait_for_endcaps(kAllEndcaps, false, t0 + 20'000'000'000))
+      << "not every end cap's DDS node came up: " << seen_text();
+  std::printf("MEASURE discovery of 12 end-cap processes: %.0f ms\n", static_cast<double>(Station::now_ns() - t0) / 1e6);
 
   // 1. Upload through the program an operator uses.
   const fs::path policy = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";

@@ -67,7 +67,7 @@ class StatusOnce : public ::testing::Test {
     fs::remove_all(dir_);
   }
   int status(std::vector<std::string> args, std::string& out, std::string& err) {
-    args.insert(args.begin(), {TENSEGRITY_CLI, "status", "--once", "--domain", std::to_string(kDomain)});
+    args.insert(args.begin(), {TENSEGRITY_CLI, "status", "--once", "--domain", std::to_string(kDomain), "--insecure"});
     Subprocess cli(args, dir_ / "cli.out", dir_ / "cli.err");
     const int rc = cli.wait_exit(std::chrono::seconds(60));
     std::ifstream o(dir_ / "cli.out"), e(dir_ / "cli.err");

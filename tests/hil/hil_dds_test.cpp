@@ -5,6 +5,7 @@
 // stop the end caps stop when they lose the host.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,14 @@ namespace tensegrity::hil {
 namespace {
 
 using namespace hil_test;
+
+// The same policy for the same time, in-process: what an open-loop lockstep run must roll.
+double in_process_m(const std::filesystem::path& policy, double duration_s) {
+  sim::CoreController reference(robot(), sim::load_policy(policy, robot()));
+  sim::EpisodeOptions eo;
+  eo.duration_s = duration_s;
+  return sim::run_episode(robot(), reference, eo).distance_m;
+}
 
 ScenarioEvent link_event(double time_s, FaultKind fault) {
   ScenarioEvent e;
@@ -42,12 +51,36 @@ TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
   EXPECT_TRUE(child_pids().empty());
 }
 
+// `tensegrity hil --keystore DIR`: the ground station and the twelve end caps speak
+// DDS Security with a keystore's enclaves. Open loop and lockstep, the secured
+// link changes nothing the physics sees: the in-process distance, to the drives'
+// position quantisation.
+TEST(HilDds, ASecuredRunRollsAsTheSimulatorDoes) {
+  const double duration_s = 4.0;
+  const double ref_m = in_process_m(policy_file(), duration_s);
+
+  HilOptions o = options(duration_s, Provision::dds);
+  // One keystore for every run of this test on the machine, made on first use.
+  o.dds_keystore = std::filesystem::temp_directory_path() / "tensegrity-hil-test-keystore";
+  o.dds_discovery_timeout_s = 40.0;
+  const HilResult r = run_hil(o);
+  if (!r.ok) {
+    for (const auto& line : r.log) std::printf("%s\n", line.c_str());
+  }
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.playing, 12);
+  EXPECT_NEAR(r.distance_m, ref_m, 1e-5 * ref_m);
+  EXPECT_NE(r.provisioner.find("secured"), std::string::npos) << r.provisioner;
+  EXPECT_EQ(r.provisioner.find("unsecured"), std::string::npos) << r.provisioner;
+  for (const auto& line : r.log) {
+    if (line.rfind("dds:", 0) == 0) std::printf("%s\n", line.c_str());
+  }
+  std::printf("secured HIL: %.3f m (in-process %.3f m)\n", r.distance_m, ref_m);
+}
+
 TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
   const double duration_s = 50.0;
-  sim::CoreController reference(robot(), sim::load_policy(evolved_policy_file(), robot()));
-  sim::EpisodeOptions eo;
-  eo.duration_s = duration_s;
-  const sim::EpisodeResult ref = sim::run_episode(robot(), reference, eo);
+  const double ref_m = in_process_m(evolved_policy_file(), duration_s);
 
   HilOptions o = options(duration_s, Provision::dds);
   o.policy = evolved_policy_file();
@@ -71,11 +104,11 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
   EXPECT_GT(at_restore, at_cut + 1.0) << "the gait kept rolling while the link was cut";
   // Open loop and lockstep: the physics never knew the link was gone (the same
   // run as in-process, up to the drives' position quantisation: ~1e-7 relative).
-  EXPECT_NEAR(r.distance_m, ref.distance_m, 1e-5 * ref.distance_m);
+  EXPECT_NEAR(r.distance_m, ref_m, 1e-5 * ref_m);
   EXPECT_EQ(r.playing, 12);
   EXPECT_EQ(r.max_phase_offset_s, 0.0);
   std::printf("link cut, continue: %.3f m at the cut, %.3f m at the restore, %.3f m at the end (in-process %.3f m)\n",
-              at_cut, at_restore, r.distance_m, ref.distance_m);
+              at_cut, at_restore, r.distance_m, ref_m);
 }
 
 TEST(HilDds, LinkCutWithStopStopsTheGait) {

@@ -111,7 +111,10 @@ TEST(LiveBridge, HasNoWriterAndForwardsTelemetryToThePage) {
   std::uint64_t cursor = hub.head();
   std::uint64_t skipped = 0;
   {
-    LiveBridge bridge(robot, LiveOptions{lease.domain(), 4.0}, hub);
+    LiveOptions options;
+    options.domain = lease.domain();
+    options.status_rate_hz = 4.0;
+    LiveBridge bridge(robot, options, hub);
     const rtps::GuidPrefix_t view = bridge.participant().guid().guidPrefix;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
     const std::set<std::string> expected{msgs::kTelemetryTopic.name, msgs::kEndcapHeartbeatTopic.name};

@@ -171,6 +171,7 @@ void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
   EXPECT_EQ(a.drive_abort_connection, b.drive_abort_connection);
   EXPECT_EQ(a.start_on_boot, b.start_on_boot);
   EXPECT_EQ(a.stats_log_period_s, b.stats_log_period_s);
+  EXPECT_EQ(a.dds_keystore, b.dds_keystore);
 }
 
 TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
@@ -181,12 +182,25 @@ TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
   full["drive_abort_connection"] = "fault";
   full["start_on_boot"] = true;
   full["stats_log_period_s"] = 2.5;
+  full["dds_keystore"] = "/etc/tensegrity/keystore";
   for (const json& doc : {example(), full}) {
     const EndcapAppConfig c = parse_config(doc.dump(), 7);
     const std::string written = config_to_json_text(c);
     expect_same(parse_config(written, 7), c);
     EXPECT_EQ(config_to_json_text(parse_config(written, 7)), written) << "a fixed point";
   }
+}
+
+TEST(EndcapConfig, TheDdsKeystoreIsAFolderOrLeftOut) {
+  json j = example();
+  j.erase("dds_keystore");
+  EXPECT_TRUE(parse_config(j.dump(), 1).dds_keystore.empty());
+  j["dds_keystore"] = "/k";
+  EXPECT_EQ(parse_config(j.dump(), 1).dds_keystore, std::filesystem::path("/k"));
+  j["dds_keystore"] = "";
+  EXPECT_THAT(error_of(j), HasSubstr("dds_keystore: must be a non-empty string"));
+  j["dds_keystore"] = 3;
+  EXPECT_THAT(error_of(j), HasSubstr("dds_keystore"));
 }
 
 TEST(EndcapConfig, SupervisionErrorsNameTheField) {

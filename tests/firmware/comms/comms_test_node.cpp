@@ -6,10 +6,11 @@
 //   comms_test_node --domain D [--endcaps 0-11] [--loop-hz 500] [--telemetry-hz 100]
 //     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
-//     [--stall-commands] [--dds-cut-signals]
+//     [--stall-commands] [--dds-cut-signals] [--keystore DIR]
 // --stall-commands: the stub loops never take a command from the mailbox (it
 // fills up), but read the emergency-stop counter every cycle.
 // --dds-cut-signals: SIGUSR1 cuts every node's DDS link, SIGUSR2 restores it.
+// --keystore: DDS Security, end cap N with the keystore's enclave endcap_NN.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -25,6 +26,7 @@
 #include "firmware/comms/endcap_node.hpp"
 #include "firmware/app/policy_store.hpp"
 #include "firmware/hal/storage.hpp"
+#include "msgs/security.hpp"
 #include "tests/firmware/comms/stub_loop.hpp"
 
 namespace {
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
   std::string storage_dir;
   bool stall_commands = false;
   bool cut_signals = false;
+  std::string keystore;
   fw::comms::EndcapNodeConfig base;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -93,6 +96,7 @@ int main(int argc, char** argv) {
       else if (arg == "--quiet") base.log = false;
       else if (arg == "--stall-commands") stall_commands = true;
       else if (arg == "--dds-cut-signals") cut_signals = true;
+      else if (arg == "--keystore") keystore = value();
       else throw std::invalid_argument("unknown argument " + arg);
     }
     if (domain < 0) throw std::invalid_argument("--domain is required");
@@ -129,6 +133,9 @@ int main(int argc, char** argv) {
       fw::comms::EndcapNodeConfig config = base;
       config.endcap_id = e;
       config.domain = domain;
+      if (!keystore.empty()) {
+        config.enclave_dir = msgs::enclave_dir(keystore, msgs::enclave_name(msgs::Role::endcap, e));
+      }
       if ((stop_set & (1U << e)) != 0) config.host_loss = fw::comms::HostLossAction::stop;
       c.node = std::make_unique<fw::comms::EndcapNode>(config, *c.clock, c.store.get());
       c.loop = std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count,

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity security init DIR`: a DDS Security keystore (ground/keystore.hpp) with
+// the project CA, the ground, 12 end-cap and listener enclaves and their signed
+// governance and permissions; `security check DIR` says whether one is complete.
+#include <cstdio>
+
+#include "cli/commands.hpp"
+#include "ground/keystore.hpp"
+#include "msgs/security.hpp"
+
+namespace tensegrity::cli {
+
+void add_security_command(CLI::App& app) {
+  CLI::App* security = app.add_subcommand("security", "DDS Security keystores (SROS2 layout)");
+  security->require_subcommand(1);
+
+  struct InitArgs {
+    std::string dir;
+    ground::KeystoreOptions options;
+  };
+  auto init = std::make_shared<InitArgs>();
+  CLI::App* cmd = security->add_subcommand(
+      "init", "Create a keystore: project CA, ground / endcap_00..11 / listener enclaves, signed documents");
+  cmd->add_option("dir", init->dir, "Keystore folder (default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore)");
+  cmd->add_option("--days", init->options.valid_days, "Validity of certificates and permissions, days")
+      ->check(CLI::Range(1, 36500))
+      ->capture_default_str();
+  cmd->add_flag("--force", init->options.replace, "Replace an existing keystore (a new CA: every end cap needs its enclave again)");
+  cmd->callback([init] {
+    const std::filesystem::path dir = init->dir.empty() ? msgs::default_keystore() : std::filesystem::path(init->dir);
+    try {
+      ground::create_keystore(dir, init->options);
+    } catch (const ground::KeystoreError& e) {
+      throw CommandError(1, e.what());
+    }
+    std::printf("keystore %s: CA, %zu enclaves (ground, endcap_00..11, listener), valid %d days\n",
+                dir.string().c_str(), msgs::all_enclaves().size(), init->options.valid_days);
+    std::printf("end cap N on its board: copy %s/enclaves/tensegrity/endcap_NN and set \"dds_keystore\"\n",
+                dir.string().c_str());
+  });
+
+  auto check_dir = std::make_shared<std::string>();
+  CLI::App* check = security->add_subcommand("check", "Exit 0 when a keystore has every enclave's files");
+  check->add_option("dir", *check_dir, "Keystore folder (default as for init)");
+  check->callback([check_dir] {
+    const std::filesystem::path dir = check_dir->empty() ? msgs::default_keystore() : std::filesystem::path(*check_dir);
+    for (const std::string& enclave : msgs::all_enclaves()) {
+      try {
+        msgs::check_enclave(msgs::enclave_files(msgs::enclave_dir(dir, enclave)));
+      } catch (const msgs::DdsError& e) {
+        throw CommandError(1, e.what());
+      }
+    }
+    std::printf("keystore %s: complete (%zu enclaves)\n", dir.string().c_str(), msgs::all_enclaves().size());
+  });
+}
+
+}  // namespace tensegrity::cli

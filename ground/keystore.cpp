@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ground/keystore.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "msgs/security.hpp"
+
+extern char** environ;
+
+namespace tensegrity::ground {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Runs `openssl ARGS...` (no shell), its output into `log`; throws with the log's
+// text when it fails.
+void openssl(std::vector<std::string> args, const fs::path& log) {
+  args.insert(args.begin(), "openssl");
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, "openssl", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) throw KeystoreError(std::string("cannot run openssl (Debian package openssl): ") + std::strerror(rc));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string cmd;
+  for (std::size_t i = 0; i + 1 < argv.size(); ++i) cmd += std::string(i ? " " : "") + argv[i];
+  throw KeystoreError(cmd + " failed:\n" + text);
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) throw KeystoreError("cannot write " + path.string());
+}
+
+std::string utc(std::time_t t) {
+  std::tm tm{};
+  ::gmtime_r(&t, &tm);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &tm);
+  return text;
+}
+
+// "/tensegrity/ground" -> "/CN=\/tensegrity\/ground" (openssl -subj escapes '/').
+std::string subj(const std::string& enclave) {
+  std::string out = "/CN=";
+  for (char c : enclave) out += (c == '/') ? std::string("\\/") : std::string(1, c);
+  return out;
+}
+
+msgs::Role role_of(const std::string& enclave) {
+  if (enclave == msgs::enclave_name(msgs::Role::ground)) return msgs::Role::ground;
+  if (enclave == msgs::enclave_name(msgs::Role::listener)) return msgs::Role::listener;
+  return msgs::Role::endcap;
+}
+
+void sign(const fs::path& in, const fs::path& out, const fs::path& ca_cert, const fs::path& ca_key,
+          const fs::path& log) {
+  // S/MIME with the document as text, as SROS2 signs them and Fast DDS reads them.
+  openssl({"smime", "-sign", "-text", "-in", in.string(), "-out", out.string(), "-signer", ca_cert.string(), "-inkey",
+           ca_key.string()},
+          log);
+}
+
+void make_enclave(const fs::path& root, const std::string& enclave, int serial, const KeystoreOptions& options,
+                  const fs::path& log) {
+  const fs::path dir = msgs::enclave_dir(root, enclave);
+  const fs::path ca_cert = root / "public" / "ca.cert.pem", ca_key = root / "private" / "ca.key.pem";
+  fs::create_directories(dir);
+  const std::string req = (dir / "req.pem").string();
+  openssl({"req", "-new", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes", "-keyout",
+           (dir / "key.pem").string(), "-out", req, "-subj", subj(enclave)},
+          log);
+  openssl({"x509", "-req", "-in", req, "-CA", ca_cert.string(), "-CAkey", ca_key.string(), "-set_serial",
+           std::to_string(serial), "-days", std::to_string(options.valid_days), "-sha256", "-out",
+           (dir / "cert.pem").string()},
+          log);
+  fs::remove(req);
+  fs::permissions(dir / "key.pem", fs::perms::owner_read | fs::perms::owner_write);
+  fs::copy_file(ca_cert, dir / "identity_ca.cert.pem");
+  fs::copy_file(ca_cert, dir / "permissions_ca.cert.pem");
+  fs::copy_file(root / "enclaves" / "governance.p7s", dir / "governance.p7s");
+  // Valid from a day back: an end cap's clock a little behind the ground's must not
+  // find its own permissions "not yet valid".
+  const std::time_t now = std::time(nullptr);
+  write_text(dir / "permissions.xml",
+             msgs::permissions_xml(enclave, role_of(enclave), utc(now - 86400),
+                                   utc(now + static_cast<std::time_t>(options.valid_days) * 86400)));
+  sign(dir / "permissions.xml", dir / "permissions.p7s", ca_cert, ca_key, log);
+}
+
+void build(const fs::path& root, const KeystoreOptions& options) {
+  const fs::path log = root / "openssl.log";
+  fs::create_directories(root / "public");
+  fs::create_directories(root / "private");
+  fs::create_directories(root / "enclaves");
+  fs::permissions(root / "private", fs::perms::owner_all);
+  const fs::path ca_cert = root / "public" / "ca.cert.pem", ca_key = root / "private" / "ca.key.pem";
+  // digitalSignature beside the CA usages: the CA itself signs the governance and
+  // permissions (S/MIME), which a verifier otherwise refuses as the wrong purpose.
+  openssl({"req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes", "-keyout",
+           ca_key.string(), "-out", ca_cert.string(), "-days", std::to_string(options.valid_days), "-sha256", "-subj",
+           "/CN=tensegrity keystore CA", "-addext", "basicConstraints=critical,CA:TRUE", "-addext",
+           "keyUsage=critical,keyCertSign,cRLSign,digitalSignature"},
+          log);
+  for (const char* name : {"identity_ca", "permissions_ca"}) {
+    fs::create_symlink("ca.cert.pem", root / "public" / (std::string(name) + ".cert.pem"));
+    fs::create_symlink("ca.key.pem", root / "private" / (std::string(name) + ".key.pem"));
+  }
+  write_text(root / "enclaves" / "governance.xml", msgs::governance_xml());
+  sign(root / "enclaves" / "governance.xml", root / "enclaves" / "governance.p7s", ca_cert, ca_key, log);
+  int serial = 1;
+  for (const std::string& enclave : msgs::all_enclaves()) make_enclave(root, enclave, serial++, options, log);
+  fs::remove(log);
+}
+
+fs::path staging_dir(const fs::path& dir) {
+  std::string templ = (dir.parent_path() / (dir.filename().string() + ".new-XXXXXX")).string();
+  if (::mkdtemp(templ.data()) == nullptr) {
+    throw KeystoreError("cannot create a folder beside " + dir.string() + ": " + std::strerror(errno));
+  }
+  return templ;
+}
+
+}  // namespace
+
+bool keystore_complete(const fs::path& dir) {
+  try {
+    for (const std::string& enclave : msgs::all_enclaves()) {
+      msgs::check_enclave(msgs::enclave_files(msgs::enclave_dir(dir, enclave)));
+    }
+    return true;
+  } catch (const msgs::DdsError&) {
+    return false;
+  }
+}
+
+void create_keystore(const fs::path& dir_in, const KeystoreOptions& options) {
+  if (options.valid_days < 1) throw KeystoreError("valid_days = " + std::to_string(options.valid_days) + ": expected >= 1");
+  const fs::path dir = fs::absolute(dir_in).lexically_normal();
+  if (fs::exists(dir) && !options.replace) {
+    throw KeystoreError(dir.string() + " exists (pass --force to replace it: every end cap then needs its enclave again)");
+  }
+  fs::create_directories(dir.parent_path());
+  const fs::path staging = staging_dir(dir);
+  try {
+    build(staging, options);
+    if (options.replace && fs::exists(dir)) fs::remove_all(dir);
+    fs::rename(staging, dir);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    throw;
+  }
+}
+
+bool ensure_keystore(const fs::path& dir_in) {
+  const fs::path dir = fs::absolute(dir_in).lexically_normal();
+  if (keystore_complete(dir)) return false;
+  if (fs::exists(dir) && !fs::is_empty(dir)) {
+    throw KeystoreError(dir.string() + " is not a complete tensegrity keystore (recreate it: tensegrity security init " +
+                        dir.string() + " --force)");
+  }
+  fs::create_directories(dir.parent_path());
+  const fs::path staging = staging_dir(dir);
+  try {
+    build(staging, KeystoreOptions{});
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove_all(staging, ignored);
+    throw;
+  }
+  std::error_code ec;
+  if (fs::exists(dir) && fs::is_empty(dir)) fs::remove(dir, ec);
+  fs::rename(staging, dir, ec);
+  if (!ec) return true;
+  // Another process renamed its keystore into place first: use that one.
+  fs::remove_all(staging, ec);
+  if (!keystore_complete(dir)) throw KeystoreError("keystore " + dir.string() + " appeared incomplete");
+  return false;
+}
+
+}  // namespace tensegrity::ground

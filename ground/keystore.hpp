@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: Apache-2.0
+// A DDS Security keystore laid out as SROS2's (`ros2 security create_keystore` +
+// `create_enclave`), so ROS 2 users recognise it and a ROS 2 node given the listener
+// enclave can read the robot's topics:
+//   KEYSTORE/public/ca.cert.pem (+ identity_ca / permissions_ca links)
+//   KEYSTORE/private/ca.key.pem (+ links; 0700)
+//   KEYSTORE/enclaves/governance.xml, governance.p7s
+//   KEYSTORE/enclaves/tensegrity/<name>/cert.pem key.pem identity_ca.cert.pem
+//       permissions_ca.cert.pem governance.p7s permissions.xml permissions.p7s
+// One project CA (ECDSA P-256) is both the identity and the permissions CA. Keys,
+// certificates and S/MIME signatures are made by Debian's `openssl` command: the
+// library's X.509 and PKCS#7 builders would be a few hundred lines that this one
+// well-kept tool already is. Enclave folders hold copies, not links, so one can be
+// copied to an end cap's board as it is. docs/security.md.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+
+namespace tensegrity::ground {
+
+class KeystoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct KeystoreOptions {
+  int valid_days = 3650;
+  bool replace = false;  // replace an existing keystore (new CA: every board needs its enclave again)
+};
+
+// Creates a complete keystore at `dir`: built in a sibling folder and renamed into
+// place, so a reader never sees half of one. Throws KeystoreError if `dir` exists
+// (unless options.replace) or openssl fails (its message included).
+void create_keystore(const std::filesystem::path& dir, const KeystoreOptions& options = {});
+
+// True when every enclave of the project (ground, 12 end caps, listener) has all its files.
+bool keystore_complete(const std::filesystem::path& dir);
+
+// The keystore at `dir`, created first if it is not there. Safe when several
+// processes race to create the same one (the first rename wins, the rest use it).
+// Returns true when this call created it.
+bool ensure_keystore(const std::filesystem::path& dir);
+
+}  // namespace tensegrity::ground

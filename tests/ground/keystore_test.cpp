@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: Apache-2.0
+// `tensegrity security init`'s keystore: SROS2's layout, every enclave complete,
+// documents signed by the CA (checked with openssl, as a second reader), private
+// keys readable by their owner only, never half-written, safe to race for.
+#include "ground/keystore.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+
+#include "msgs/security.hpp"
+
+namespace tensegrity::ground {
+namespace {
+
+namespace fs = std::filesystem;
+
+class Keystore : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("keystore_test_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  static int sh(const std::string& command) { return std::system((command + " >/dev/null 2>&1").c_str()); }
+  fs::path dir_;
+};
+
+TEST_F(Keystore, InitMakesSros2sLayoutWithSignedDocuments) {
+  const fs::path ks = dir_ / "ks";
+  create_keystore(ks);
+  EXPECT_TRUE(keystore_complete(ks));
+  EXPECT_TRUE(fs::exists(ks / "public" / "ca.cert.pem"));
+  EXPECT_TRUE(fs::exists(ks / "public" / "identity_ca.cert.pem"));
+  EXPECT_TRUE(fs::exists(ks / "private" / "permissions_ca.key.pem"));
+  EXPECT_TRUE(fs::exists(ks / "enclaves" / "governance.p7s"));
+  const fs::path ca = ks / "public" / "ca.cert.pem";
+  for (const std::string& enclave : msgs::all_enclaves()) {
+    SCOPED_TRACE(enclave);
+    const fs::path e = msgs::enclave_dir(ks, enclave);
+    for (const char* doc : {"permissions.p7s", "governance.p7s"}) {
+      EXPECT_EQ(sh("openssl smime -verify -in " + (e / doc).string() + " -CAfile " + ca.string()), 0) << doc;
+    }
+    EXPECT_EQ(sh("openssl verify -CAfile " + ca.string() + " " + (e / "cert.pem").string()), 0);
+    // The certificate's subject is the one the permissions grant names.
+    EXPECT_EQ(sh("openssl x509 -in " + (e / "cert.pem").string() + " -noout -subject -nameopt RFC2253 | grep -qx 'subject=" +
+                 msgs::subject_name(enclave) + "'"),
+              0);
+    EXPECT_EQ(fs::status(e / "key.pem").permissions() & (fs::perms::group_all | fs::perms::others_all), fs::perms::none);
+  }
+  EXPECT_EQ(sh("openssl smime -verify -in " + (msgs::enclave_dir(ks, "/tensegrity/ground") / "permissions.p7s").string() +
+               " -CAfile " + ca.string() + " | grep -q 'rt/tensegrity/command'"),
+            0);
+}
+
+TEST_F(Keystore, AnExistingKeystoreIsKeptUnlessReplaced) {
+  const fs::path ks = dir_ / "ks";
+  create_keystore(ks);
+  std::ifstream before(ks / "public" / "ca.cert.pem");
+  const std::string ca_before((std::istreambuf_iterator<char>(before)), {});
+  EXPECT_THROW(create_keystore(ks), KeystoreError);
+  EXPECT_FALSE(ensure_keystore(ks)) << "complete: kept";
+  KeystoreOptions replace;
+  replace.replace = true;
+  create_keystore(ks, replace);
+  std::ifstream after(ks / "public" / "ca.cert.pem");
+  EXPECT_NE(ca_before, std::string((std::istreambuf_iterator<char>(after)), {})) << "a new CA";
+  EXPECT_TRUE(keystore_complete(ks));
+}
+
+TEST_F(Keystore, AnIncompleteFolderIsRefusedNotFilledIn) {
+  const fs::path ks = dir_ / "ks";
+  fs::create_directories(ks / "enclaves");
+  std::ofstream(ks / "enclaves" / "stray.txt") << "x";
+  EXPECT_THROW(ensure_keystore(ks), KeystoreError);
+}
+
+TEST_F(Keystore, ProcessesRacingToCreateOneAllGetTheSameComplete) {
+  const fs::path ks = dir_ / "race";
+  std::atomic<int> created{0};
+  std::vector<std::thread> threads;
+  for (int i = 0; i < 3; ++i) {
+    threads.emplace_back([&] { created += ensure_keystore(ks) ? 1 : 0; });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(created.load(), 1);
+  EXPECT_TRUE(keystore_complete(ks));
+  int leftovers = 0;
+  for (const auto& entry : fs::directory_iterator(dir_)) leftovers += entry.path() != ks ? 1 : 0;
+  EXPECT_EQ(leftovers, 0) << "staging folders removed";
+}
+
+}  // namespace
+}  // namespace tensegrity::ground

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: Apache-2.0
+// DDS Security over real DDS (loopback): three end caps (comms_test_node) with
+// their enclaves of a keystore made by ground::create_keystore, and hosts with
+// other identities. Only the keystore's ground identity is heard and obeyed; an
+// unauthenticated participant, one of another CA, and one holding an end cap's
+// identity may not upload, start, clear a fault or answer a time sync. Domains 175-178.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <thread>
+
+#include "ground/command.hpp"
+#include "ground/keystore.hpp"
+#include "ground/station.hpp"
+#include "ground/upload.hpp"
+#include "msgs/security.hpp"
+#include "sim/policy.hpp"
+#include "sim/robot.hpp"
+#include "tests/ground/rogue_time_server.hpp"
+#include "tests/ground/subprocess.hpp"
+
+namespace tensegrity::ground {
+namespace {
+
+namespace fs = std::filesystem;
+using test::RogueTimeServer;
+using test::Subprocess;
+
+constexpr std::uint16_t kThree = 0b111;  // end caps 0, 1, 2
+
+std::int64_t after_s(double s) { return Station::now_ns() + static_cast<std::int64_t>(s * 1e9); }
+
+class SecureDds : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("security_dds_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    create_keystore(root_ / "keystore");
+    create_keystore(root_ / "foreign");  // another CA: same names, other keys
+  }
+  static void TearDownTestSuite() { fs::remove_all(root_); }
+  void TearDown() override {
+    if (HasFailure() && nodes_) {
+      std::ifstream in(root_ / "nodes.err");
+      std::printf("--- nodes stderr\n%s\n", std::string((std::istreambuf_iterator<char>(in)), {}).c_str());
+    }
+    nodes_.reset();
+  }
+  static fs::path enclave(const std::string& store, msgs::Role role, int id = -1) {
+    return msgs::enclave_dir(root_ / store, msgs::enclave_name(role, id));
+  }
+  void start_nodes(int domain) {
+    nodes_ = std::make_unique<Subprocess>(
+        std::vector<std::string>{COMMS_TEST_NODE, "--domain", std::to_string(domain), "--endcaps", "0-2", "--keystore",
+                                 (root_ / "keystore").string()},
+        root_ / "nodes.out", root_ / "nodes.err");
+    ASSERT_TRUE(nodes_->wait_for_output("READY", std::chrono::seconds(30)));
+  }
+  static std::unique_ptr<Station> station(int domain, const fs::path& enclave_dir, bool serve_time = true) {
+    StationOptions o;
+    o.domain = domain;
+    o.name = "security_test_host";
+    o.enclave_dir = enclave_dir;
+    o.serve_time = serve_time;
+    o.publish_heartbeat = serve_time;
+    return std::make_unique<Station>(o);
+  }
+  static CommandReport command(Station& s, CommandKind kind, double timeout_s) {
+    CommandOptions o;
+    o.endcap_mask = kThree;
+    o.timeout_s = timeout_s;
+    return send_command(s, kind, 0, o);
+  }
+  // The shipped policy's tables for end caps 0-2, as `tensegrity upload` makes them.
+  static std::vector<msg::PolicyTable_> tables() {
+    const fs::path file = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
+    const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(file));
+    auto all = policy_messages(sim::load_policy(file, robot), robot,
+                               fw::comms::PolicyIdentity{"secured_gait", 7, robot.name, false}, random_sequence_base());
+    std::erase_if(all, [](const auto& t) { return t.target_endcap() > 2; });
+    return all;
+  }
+  bool nodes_printed(const std::string& word) const { return nodes_->output().find(word) != std::string::npos; }
+
+  static fs::path root_;
+  std::unique_ptr<Subprocess> nodes_;
+};
+
+fs::path SecureDds::root_;
+
+TEST_F(SecureDds, TheGroundIdentityIsHeardAndObeyed) {
+  constexpr int kDomain = 175;
+  start_nodes(kDomain);
+  auto ground = station(kDomain, enclave("keystore", msgs::Role::ground));
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(ground->wait_for_endcaps(kThree, true, after_s(30))) << "secured discovery + time sync";
+  std::printf("MEASURE secured discovery and time sync of 3 end caps: %.0f ms\n",
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  UploadOptions uo;
+  uo.timeout_s = 10.0;
+  const UploadReport upload_report = upload(*ground, tables(), uo);
+  EXPECT_TRUE(upload_report.all_accepted()) << format_upload_report(upload_report);
+  const CommandReport estop = command(*ground, CommandKind::emergency_stop, 5.0);
+  EXPECT_TRUE(estop.all_accepted()) << format_command_report(estop);
+  ASSERT_TRUE(nodes_->wait_for_output("ESTOPPED", std::chrono::seconds(5)));
+  const CommandReport clear = command(*ground, CommandKind::clear_fault, 5.0);
+  EXPECT_TRUE(clear.all_accepted()) << format_command_report(clear);
+  EXPECT_TRUE(nodes_->wait_for_output("CLEARED", std::chrono::seconds(5)));
+}
+
+TEST_F(SecureDds, AnUnauthenticatedOrForeignHostIsNotHeard) {
+  constexpr int kDomain = 176;
+  start_nodes(kDomain);
+  // A watcher with the right identity that neither serves time nor commands.
+  auto watcher = station(kDomain, enclave("keystore", msgs::Role::ground), false);
+  ASSERT_TRUE(watcher->wait_for_endcaps(kThree, false, after_s(30)));
+  for (const fs::path& who : {fs::path(), enclave("foreign", msgs::Role::ground)}) {
+    SCOPED_TRACE(who.empty() ? "unauthenticated" : "foreign CA");
+    auto intruder = station(kDomain, who);
+    RogueTimeServer rogue(kDomain, who);
+    EXPECT_FALSE(intruder->wait_for_endcaps(kThree, false, after_s(3))) << "it must not even see the end caps";
+    UploadOptions uo;
+    uo.timeout_s = 1.0;
+    const UploadReport uploaded = upload(*intruder, tables(), uo);
+    for (const auto& r : uploaded.results) EXPECT_FALSE(r.acked) << "upload, end cap " << r.endcap;
+    const CommandReport estop = command(*intruder, CommandKind::emergency_stop, 1.0);
+    const CommandReport clear = command(*intruder, CommandKind::clear_fault, 1.0);
+    const CommandReport start = command(*intruder, CommandKind::start, 1.0);
+    for (const auto* report : {&estop, &clear, &start}) {
+      for (const auto& r : report->results) EXPECT_FALSE(r.acked) << "end cap " << r.endcap;
+    }
+    EXPECT_EQ(rogue.answered(), 0U) << "it must not even see a time-sync request";
+  }
+  EXPECT_FALSE(nodes_printed("ESTOPPED")) << "an intruder's emergency stop acted";
+  const auto status = watcher->snapshot();
+  for (int e = 0; e < 3; ++e) {
+    EXPECT_FALSE(status[e].heartbeat.clock_synced()) << "end cap " << e << " took an intruder's time";
+  }
+}
+
+TEST_F(SecureDds, AnEndcapIdentityCannotGiveOrders) {
+  constexpr int kDomain = 177;
+  // Its permissions grant no command, table, host-heartbeat or time-sync-reply
+  // writer: Fast DDS refuses to create them (and a remote end cap would refuse to
+  // match one it saw, DDS-Security's check_remote_datawriter).
+  const fs::path endcap5 = enclave("keystore", msgs::Role::endcap, 5);
+  EXPECT_THROW(station(kDomain, endcap5), msgs::DdsError);
+  EXPECT_THROW(RogueTimeServer(kDomain, endcap5), msgs::DdsError);
+  // Its certificate with the ground's signed permissions: the grant's subject is
+  // not the certificate's, so the participant is refused at creation.
+  const fs::path mixed = root_ / "mixed";
+  fs::create_directories(mixed);
+  for (const char* f : {"cert.pem", "key.pem", "identity_ca.cert.pem", "permissions_ca.cert.pem", "governance.p7s"}) {
+    fs::copy_file(endcap5 / f, mixed / f, fs::copy_options::overwrite_existing);
+  }
+  fs::copy_file(enclave("keystore", msgs::Role::ground) / "permissions.p7s", mixed / "permissions.p7s",
+                fs::copy_options::overwrite_existing);
+  EXPECT_THROW(station(kDomain, mixed), msgs::DdsError);
+  // A listener (read-only) identity may watch but not command.
+  EXPECT_THROW(station(kDomain, enclave("keystore", msgs::Role::listener)), msgs::DdsError);
+}
+
+TEST_F(SecureDds, AMissingEnclaveFileIsNamed) {
+  const fs::path broken = root_ / "broken";
+  fs::create_directories(broken);
+  fs::copy_file(enclave("keystore", msgs::Role::ground) / "cert.pem", broken / "cert.pem",
+                fs::copy_options::overwrite_existing);
+  try {
+    station(178, broken);
+    FAIL() << "no error";
+  } catch (const msgs::DdsError& e) {
+    EXPECT_NE(std::string(e.what()).find("identity_ca.cert.pem"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace tensegrity::ground
