@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -162,9 +161,8 @@ ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double dura
   o.mode = mode;
   o.provision = args.provision == "local" ? hil::Provision::local : hil::Provision::dds;
 #ifdef TENSEGRITY_CLI_DDS
-  // --keystore DIR or --secure: what DDS Security costs, beside an unsecured run.
-  const char* env = std::getenv("TENSEGRITY_KEYSTORE");
-  if (!args.insecure && (args.secure || !args.keystore.empty() || (env != nullptr && *env != '\0'))) {
+  // Secured as `tensegrity hil` runs by default; --insecure measures without.
+  if (!args.insecure) {
     o.dds_keystore = args.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(args.keystore);
   }
 #endif
@@ -355,7 +353,7 @@ void add_bench_hil_command(CLI::App& bench) {
   cmd->add_flag("--json", args->json, "Print one JSON object");
 #ifdef TENSEGRITY_CLI_DDS
   add_security_options(*cmd, args->keystore, args->insecure);
-  cmd->add_flag("--secure", args->secure, "DDS Security with the default keystore (made if missing)");
+  cmd->add_flag("--secure", args->secure, "DDS Security with the default keystore (the default; made if missing)");
 #endif
   cmd->callback([args] { run_bench_hil(*args); });
 }

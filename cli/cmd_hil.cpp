@@ -6,7 +6,6 @@
 
 #include <cstddef>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -84,15 +83,11 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
   o.host_loss = a.host_loss;
   o.dds_domain = a.domain;
-  // Secured with --keystore DIR or --secure (the default keystore); the HIL runs
-  // both ends, so it makes the keystore if there is none yet. Unsecured by default
-  // for now: docs/security.md says why.
+  // Secured unless --insecure, with --keystore DIR or the default keystore; the HIL
+  // runs both ends, so it makes the keystore if there is none yet.
 #ifdef TENSEGRITY_CLI_DDS
   if (a.secure && a.insecure) throw CommandError(2, "hil: --secure and --insecure exclude each other");
-  const char* env = std::getenv("TENSEGRITY_KEYSTORE");
-  if (!a.insecure && (a.secure || !a.keystore.empty() || (env != nullptr && *env != '\0'))) {
-    o.dds_keystore = a.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(a.keystore);
-  }
+  if (!a.insecure) o.dds_keystore = a.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(a.keystore);
 #endif
   const sim::Robot robot = sim::load_robot(a.robot.empty() ? sim::robot_path_for_policy(o.policy) : std::filesystem::path(a.robot));
   try {
@@ -191,7 +186,7 @@ void add_hil_command(CLI::App& app) {
 #ifdef TENSEGRITY_CLI_DDS
   add_security_options(*cmd, args->keystore, args->insecure);
   cmd->add_flag("--secure", args->secure,
-                "dds: DDS Security with the default keystore (TENSEGRITY_KEYSTORE, else "
+                "dds: DDS Security with the default keystore (the default; TENSEGRITY_KEYSTORE, else "
                 "~/.local/share/tensegrity/keystore; made if missing)");
 #endif
   cmd->add_option("--disable-cable", args->disabled_cables,

@@ -24,16 +24,21 @@ void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_ti
 void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure) {
   auto* k = cmd.add_option("--keystore", keystore,
                            "DDS Security keystore (tensegrity security init): speak with its ground identity "
-                           "(default: TENSEGRITY_KEYSTORE if set, else unsecured)");
+                           "(default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore if it exists, "
+                           "else unsecured)");
   auto* i = cmd.add_flag("--insecure", insecure, "Unauthenticated, unencrypted DDS even if TENSEGRITY_KEYSTORE is set");
   k->excludes(i);
 }
 
 std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure) {
   if (insecure) return {};
+  // The default keystore is the one `tensegrity hil` makes and uses: when it is
+  // there, the tools speak with it, so they hear a HIL run without flags.
   const char* env = std::getenv("TENSEGRITY_KEYSTORE");
-  if (keystore.empty() && (env == nullptr || *env == '\0')) {
-    std::fprintf(stderr, "tensegrity: DDS link unsecured (no --keystore or TENSEGRITY_KEYSTORE; docs/security.md)\n");
+  const bool named = !keystore.empty() || (env != nullptr && *env != '\0');
+  if (!named && !std::filesystem::exists(msgs::default_keystore())) {
+    std::fprintf(stderr, "tensegrity: DDS link unsecured (no keystore: --keystore, TENSEGRITY_KEYSTORE or %s; "
+                 "docs/security.md)\n", msgs::default_keystore().c_str());
     return {};
   }
   const std::filesystem::path store = keystore.empty() ? msgs::default_keystore() : std::filesystem::path(keystore);
