@@ -29,10 +29,11 @@ LinkTiming DdsProvisioner::link_timing() const {
 }
 
 // Fast DDS 2.9's PKI-DH handshake between two processes now and then never
-// completes (measured: 2 of 8 secured 12-end-cap runs left one end cap unheard for
-// 40 s, 4 of 7 with a signing-only governance). A new ground participant (a new
-// GUID) authenticates afresh; so when the set of end caps heard stops growing for
-// kRejoinAfterNs short of all, the station joins again.
+// completes (docs/security.md: with two secured HIL runs at once, 2 of 8 left one end
+// cap unheard for 40 s; alone, 2 of 10 stalled and were recovered by this). A new
+// ground participant (a new GUID) authenticates afresh; so when the set of end caps
+// heard stops growing for kRejoinAfterNs short of all (or all heard but not every
+// clock synchronized), the station joins again.
 bool DdsProvisioner::wait_or_rejoin(std::uint16_t mask, std::int64_t deadline_ns) {
   constexpr std::int64_t kRejoinAfterNs = 8 * kNsPerS;
   auto heard = [this, mask] {
