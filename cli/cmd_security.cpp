@@ -40,17 +40,11 @@ void add_security_command(CLI::App& app) {
   });
 
   auto check_dir = std::make_shared<std::string>();
-  CLI::App* check = security->add_subcommand("check", "Exit 0 when a keystore has every enclave's files");
+  CLI::App* check = security->add_subcommand("check", "Exit 0 when a keystore has every enclave's files and this version's permissions");
   check->add_option("dir", *check_dir, "Keystore folder (default as for init)");
   check->callback([check_dir] {
     const std::filesystem::path dir = check_dir->empty() ? msgs::default_keystore() : std::filesystem::path(*check_dir);
-    for (const std::string& enclave : msgs::all_enclaves()) {
-      try {
-        msgs::check_enclave(msgs::enclave_files(msgs::enclave_dir(dir, enclave)));
-      } catch (const msgs::DdsError& e) {
-        throw CommandError(1, e.what());
-      }
-    }
+    if (const std::string problem = ground::keystore_problem(dir); !problem.empty()) throw CommandError(1, problem);
     std::printf("keystore %s: complete (%zu enclaves)\n", dir.string().c_str(), msgs::all_enclaves().size());
   });
 }

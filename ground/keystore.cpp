@@ -74,12 +74,6 @@ std::string subj(const std::string& enclave) {
   return out;
 }
 
-msgs::Role role_of(const std::string& enclave) {
-  if (enclave == msgs::enclave_name(msgs::Role::ground)) return msgs::Role::ground;
-  if (enclave == msgs::enclave_name(msgs::Role::listener)) return msgs::Role::listener;
-  return msgs::Role::endcap;
-}
-
 void sign(const fs::path& in, const fs::path& out, const fs::path& ca_cert, const fs::path& ca_key,
           const fs::path& log) {
   // S/MIME with the document as text, as SROS2 signs them and Fast DDS reads them.
@@ -110,8 +104,7 @@ void make_enclave(const fs::path& root, const std::string& enclave, int serial, 
   // find its own permissions "not yet valid".
   const std::time_t now = std::time(nullptr);
   write_text(dir / "permissions.xml",
-             msgs::permissions_xml(enclave, role_of(enclave), utc(now - 86400),
-                                   utc(now + static_cast<std::time_t>(options.valid_days) * 86400)));
+             msgs::permissions_xml(enclave, utc(now - 86400), utc(now + static_cast<std::time_t>(options.valid_days) * 86400)));
   sign(dir / "permissions.xml", dir / "permissions.p7s", ca_cert, ca_key, log);
 }
 
@@ -150,16 +143,28 @@ fs::path staging_dir(const fs::path& dir) {
 
 }  // namespace
 
-bool keystore_complete(const fs::path& dir) {
-  try {
-    for (const std::string& enclave : msgs::all_enclaves()) {
-      msgs::check_enclave(msgs::enclave_files(msgs::enclave_dir(dir, enclave)));
+std::string keystore_problem(const fs::path& dir) {
+  for (const std::string& enclave : msgs::all_enclaves()) {
+    const fs::path enclave_dir = msgs::enclave_dir(dir, enclave);
+    try {
+      msgs::check_enclave(msgs::enclave_files(enclave_dir));
+    } catch (const msgs::DdsError& e) {
+      return e.what();
     }
-    return true;
-  } catch (const msgs::DdsError&) {
-    return false;
+    // The signed document is what Fast DDS reads; the .xml beside it is its text.
+    std::ifstream in(enclave_dir / "permissions.p7s");
+    const std::string signed_text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (signed_text.find(msgs::permission_rules(enclave)) == std::string::npos) {
+      return (enclave_dir / "permissions.p7s").string() +
+             ": grants other rules than this version does (a keystore made by an older version: end caps now "
+             "publish in their own partitions); recreate it with `tensegrity security init " + dir.string() +
+             " --force` and copy each end cap its enclave again";
+    }
   }
+  return {};
 }
+
+bool keystore_complete(const fs::path& dir) { return keystore_problem(dir).empty(); }
 
 void create_keystore(const fs::path& dir_in, const KeystoreOptions& options) {
   if (options.valid_days < 1) throw KeystoreError("valid_days = " + std::to_string(options.valid_days) + ": expected >= 1");
@@ -184,8 +189,7 @@ bool ensure_keystore(const fs::path& dir_in) {
   const fs::path dir = fs::absolute(dir_in).lexically_normal();
   if (keystore_complete(dir)) return false;
   if (fs::exists(dir) && !fs::is_empty(dir)) {
-    throw KeystoreError(dir.string() + " is not a complete tensegrity keystore (recreate it: tensegrity security init " +
-                        dir.string() + " --force)");
+    throw KeystoreError(dir.string() + " is not a usable tensegrity keystore: " + keystore_problem(dir));
   }
   fs::create_directories(dir.parent_path());
   const fs::path staging = staging_dir(dir);

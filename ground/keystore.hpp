@@ -16,6 +16,7 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 
 namespace tensegrity::ground {
 
@@ -34,7 +35,9 @@ struct KeystoreOptions {
 // (unless options.replace) or openssl fails (its message included).
 void create_keystore(const std::filesystem::path& dir, const KeystoreOptions& options = {});
 
-// True when every enclave of the project (ground, 12 end caps, listener) has all its files.
+// Empty when every enclave of the project (ground, 12 end caps, listener) has all
+// its files and the permissions this version grants; else what is wrong, with the fix.
+std::string keystore_problem(const std::filesystem::path& dir);
 bool keystore_complete(const std::filesystem::path& dir);
 
 // The keystore at `dir`, created first if it is not there. Safe when several

@@ -14,6 +14,7 @@
 #include <ctime>
 
 #include "msgs/dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
@@ -47,6 +48,10 @@ struct StationListeners {
     const char* topic_;
   };
 
+  // True when the writer of `info` publishes for `endcap` (its partition, which the
+  // permissions bind to its identity); else the sample is counted, said now and
+  // then, and must be dropped: an end cap speaking for another.
+  static bool vouched(Station& s, const dds::SampleInfo& info, int endcap, const char* what);
   static void policy_acks(Station& s, dds::DataReader* r);
   static void command_acks(Station& s, dds::DataReader* r);
   static void telemetry(Station& s, dds::DataReader* r);
@@ -55,6 +60,8 @@ struct StationListeners {
 };
 
 struct Station::Dds {
+  // Declared first, destroyed last: the participant (deleted in close()) calls it.
+  msgs::EndcapWriters writers;
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -97,9 +104,10 @@ std::int64_t Station::now_ns() {
 
 Station::Station(const StationOptions& options) : options_(options), dds_(std::make_unique<Dds>()) {
   Dds& d = *dds_;
-  d.participant = msgs::create_participant(options.domain, options.name, nullptr, options.enclave_dir);
+  d.participant = msgs::create_participant(options.domain, options.name, nullptr, options.enclave_dir, &d.writers);
   d.publisher = d.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-  d.subscriber = d.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  // Every end cap's reports, each from its own partition (msgs/endcap_writers.hpp).
+  d.subscriber = d.participant->create_subscriber(msgs::endcap_reports_qos());
   if (d.publisher == nullptr || d.subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
   d.policy = d.writer(msgs::kPolicyTableTopic, dds::TypeSupport(new msg::PolicyTable_PubSubType()));
   d.command = d.writer(msgs::kCommandTopic, dds::TypeSupport(new msg::Command_PubSubType()));
@@ -205,16 +213,32 @@ void Station::on_telemetry(std::function<void(const msg::Telemetry_&, std::int64
   telemetry_callback_ = std::move(callback);
 }
 
+std::uint64_t Station::impostor_samples() const {
+  std::lock_guard lock(mutex_);
+  return impostor_samples_;
+}
+
 std::uint64_t Station::time_sync_replies() const {
   std::lock_guard lock(mutex_);
   return sync_replies_;
+}
+
+bool StationListeners::vouched(Station& s, const dds::SampleInfo& info, int endcap, const char* what) {
+  const int writer_endcap = s.dds_->writers.endcap_of(info);
+  if (writer_endcap == endcap && valid_endcap(endcap)) return true;
+  std::lock_guard lock(s.mutex_);
+  if (s.impostor_samples_++ % 1000 == 0) {
+    std::fprintf(stderr, "ground: REFUSED %s claiming end cap %d from a writer of %s%d (not its partition)\n", what,
+                 endcap, writer_endcap < 0 ? "no end cap, " : "end cap ", writer_endcap);
+  }
+  return false;
 }
 
 void StationListeners::policy_acks(Station& s, dds::DataReader* r) {
   msg::PolicyAck_ ack;
   dds::SampleInfo info;
   while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data) continue;
+    if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "policy ack")) continue;
     std::lock_guard lock(s.mutex_);
     if (ack.format_version() != msgs::kFormatVersion) {
       std::fprintf(stderr, "ground: REFUSED policy ack from end cap %d: format version %u, we speak %u\n",
@@ -230,7 +254,7 @@ void StationListeners::command_acks(Station& s, dds::DataReader* r) {
   msg::CommandAck_ ack;
   dds::SampleInfo info;
   while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data) continue;
+    if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "command ack")) continue;
     std::lock_guard lock(s.mutex_);
     if (ack.format_version() != msgs::kFormatVersion) {
       std::fprintf(stderr, "ground: REFUSED command ack from end cap %d: format version %u, we speak %u\n",
@@ -247,7 +271,7 @@ void StationListeners::telemetry(Station& s, dds::DataReader* r) {
   dds::SampleInfo info;
   while (r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
     const std::int64_t now = Station::now_ns();
-    if (!info.valid_data || !valid_endcap(t.endcap_id())) continue;
+    if (!info.valid_data || !vouched(s, info, t.endcap_id(), "telemetry")) continue;
     std::function<void(const msg::Telemetry_&, std::int64_t)> callback;
     {
       std::lock_guard lock(s.mutex_);
@@ -274,7 +298,7 @@ void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
   msg::Heartbeat_ hb;
   dds::SampleInfo info;
   while (r->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || !valid_endcap(hb.source())) continue;
+    if (!info.valid_data || !vouched(s, info, hb.source(), "heartbeat")) continue;
     std::lock_guard lock(s.mutex_);
     EndcapStatus& e = s.status_[static_cast<std::size_t>(hb.source())];
     if (hb.format_version() != msgs::kFormatVersion) {
@@ -297,6 +321,7 @@ void StationListeners::time_sync(Station& s, dds::DataReader* r) {
   while (r->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
     const std::int64_t t2 = Station::now_ns();
     if (!info.valid_data || req.format_version() != msgs::kFormatVersion) continue;
+    if (!vouched(s, info, req.endcap_id(), "time-sync request")) continue;
     msg::TimeSyncReply_ reply;
     reply.format_version(msgs::kFormatVersion);
     reply.endcap_id(req.endcap_id());

@@ -86,6 +86,9 @@ class Station {
 
   // Time-sync requests answered so far (for tests and the status line).
   std::uint64_t time_sync_replies() const;
+  // Reports refused because their end cap id is not the one their writer publishes
+  // for (msgs/endcap_writers.hpp): an end cap's identity speaking for another.
+  std::uint64_t impostor_samples() const;
 
  private:
   struct Dds;
@@ -101,6 +104,7 @@ class Station {
   std::vector<msg::CommandAck_> command_acks_;
   std::function<void(const msg::Telemetry_&, std::int64_t)> telemetry_callback_;
   std::uint64_t sync_replies_ = 0;
+  std::uint64_t impostor_samples_ = 0;
   bool stopping_ = false;
   std::condition_variable stop_cv_;
   std::unique_ptr<std::thread> heartbeat_thread_;

@@ -51,7 +51,8 @@ void load_qos_profiles() {
 }
 
 dds::DomainParticipant* create_participant(int domain, const std::string& name, const std::atomic<bool>* link_cut,
-                                           const std::filesystem::path& enclave_dir) {
+                                           const std::filesystem::path& enclave_dir,
+                                           dds::DomainParticipantListener* listener) {
   load_qos_profiles();
   auto* factory = dds::DomainParticipantFactory::get_instance();
   dds::DomainParticipantQos qos;
@@ -63,7 +64,7 @@ dds::DomainParticipant* create_participant(int domain, const std::string& name, 
   if (link_cut != nullptr) {
     for (auto& transport : qos.transport().user_transports) transport = make_link_cut_transport(transport, link_cut);
   }
-  dds::DomainParticipant* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain), qos);
+  dds::DomainParticipant* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain), qos, listener, dds::StatusMask::none());
   if (participant == nullptr) {
     throw DdsError("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain) +
                    (enclave_dir.empty() ? std::string()
@@ -94,6 +95,8 @@ dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& s
   if (type.get_type_name() != spec.type) {
     throw DdsError(std::string("topic ") + spec.name + ": type " + type.get_type_name() + ", expected " + spec.type);
   }
+  // A second writer or reader of a topic on one participant shares its Topic.
+  if (auto* existing = dynamic_cast<dds::Topic*>(participant.lookup_topicdescription(spec.name))) return existing;
   dds::Topic* topic = participant.create_topic(spec.name, spec.type, dds::TOPIC_QOS_DEFAULT);
   if (topic == nullptr) throw DdsError(std::string("cannot create topic ") + spec.name);
   return topic;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -84,12 +85,15 @@ void load_qos_profiles();
 // Delete with delete_participant (deletes its entities first). With `link_cut`,
 // its transport drops every datagram in and out while *link_cut is true (fault
 // injection: msgs/link_cut_transport.hpp); the flag must outlive the participant.
-eprosima::fastdds::dds::DomainParticipant* create_participant(int domain, const std::string& name,
-                                                              const std::atomic<bool>* link_cut = nullptr,
-                                                              const std::filesystem::path& enclave_dir = {});
+// `listener` (e.g. msgs::EndcapWriters) hears discovery from the first datagram on
+// (no status callbacks: the readers' own listeners keep those); it must outlive it.
+eprosima::fastdds::dds::DomainParticipant* create_participant(
+    int domain, const std::string& name, const std::atomic<bool>* link_cut = nullptr,
+    const std::filesystem::path& enclave_dir = {}, eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
 void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
 
-// Registers `type` (once per participant) and creates the topic of `spec`.
+// Registers `type` (once per participant) and creates the topic of `spec` (or
+// returns the participant's existing one).
 eprosima::fastdds::dds::Topic* create_topic(eprosima::fastdds::dds::DomainParticipant& participant,
                                             const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type);
 

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "msgs/endcap_writers.hpp"
+
 namespace tensegrity::msgs {
 
 namespace fs = std::filesystem;
@@ -136,23 +138,51 @@ std::string governance_xml() {
 )";
 }
 
-std::string permissions_xml(const std::string& enclave, Role role, const std::string& not_before,
-                            const std::string& not_after) {
+Identity identity_of(const std::string& enclave) {
+  if (enclave == enclave_name(Role::ground)) return {Role::ground, -1};
+  if (enclave == enclave_name(Role::listener)) return {Role::listener, -1};
+  for (int id = 0; id < kMaxEndcaps; ++id) {
+    if (enclave == enclave_name(Role::endcap, id)) return {Role::endcap, id};
+  }
+  throw DdsError("enclave '" + enclave + "': not one of the project's (/tensegrity/ground, endcap_00..11, listener)");
+}
+
+std::string permission_rules(const std::string& enclave) {
+  const Identity who = identity_of(enclave);
   std::vector<std::string> publish, subscribe;
   for (const TopicSpec& t : kAllTopics) {
-    if (may_publish(role, t)) publish.emplace_back(t.name);
-    if (may_subscribe(role, t)) subscribe.emplace_back(t.name);
+    if (may_publish(who.role, t)) publish.emplace_back(t.name);
+    if (may_subscribe(who.role, t)) subscribe.emplace_back(t.name);
   }
-  if (role == Role::listener) {
-    // What a ROS 2 node publishes of its own (graph, log, parameters, services),
-    // so that a node given this enclave can start and listen.
-    publish = {"ros_discovery_info", "rt/rosout", "rt/parameter_events", "rq/*", "rr/*"};
-    subscribe = {"*"};
+  // Partitions bind an end cap's identity to its id: it writes its reports only in
+  // its own partition (msgs/endcap_writers.hpp); the ground reads every end cap's;
+  // orders travel in the default partition ("<partition/>" is the empty name).
+  std::string publish_partitions = "<partitions><partition/></partitions>";
+  std::string subscribe_partitions = "<partitions><partition/></partitions>";
+  switch (who.role) {
+    case Role::endcap:
+      publish_partitions = "<partitions><partition>" + endcap_partition(who.endcap_id) + "</partition></partitions>";
+      break;
+    case Role::ground:
+      subscribe_partitions = std::string("<partitions><partition>") + kEveryEndcapPartition + "</partition></partitions>";
+      break;
+    case Role::listener:
+      // What a ROS 2 node publishes of its own (graph, log, parameters, services),
+      // so that a node given this enclave can start and listen.
+      publish = {"ros_discovery_info", "rt/rosout", "rt/parameter_events", "rq/*", "rr/*"};
+      subscribe = {"*"};
+      subscribe_partitions =
+          std::string("<partitions><partition/><partition>") + kEveryEndcapPartition + "</partition></partitions>";
+      break;
   }
   std::string rule = std::string("<allow_rule>") + kDomains;
-  if (!publish.empty()) rule += "<publish>" + topic_list(publish) + "</publish>";
-  if (!subscribe.empty()) rule += "<subscribe>" + topic_list(subscribe) + "</subscribe>";
-  rule += "</allow_rule>";
+  if (!publish.empty()) rule += "<publish>" + topic_list(publish) + publish_partitions + "</publish>";
+  if (!subscribe.empty()) rule += "<subscribe>" + topic_list(subscribe) + subscribe_partitions + "</subscribe>";
+  return rule + "</allow_rule>";
+}
+
+std::string permissions_xml(const std::string& enclave, const std::string& not_before, const std::string& not_after) {
+  const std::string rule = permission_rules(enclave);
   return R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_permissions.xsd">
   <permissions>

@@ -27,6 +27,12 @@ inline constexpr int kMaxEndcaps = 12;
 std::string enclave_name(Role role, int endcap_id = -1);
 // KEYSTORE/enclaves/<enclave name without its leading '/'>.
 std::filesystem::path enclave_dir(const std::filesystem::path& keystore, const std::string& enclave);
+// Who an enclave name is; throws DdsError for a name that is not the project's.
+struct Identity {
+  Role role;
+  int endcap_id;  // -1 unless role is endcap
+};
+Identity identity_of(const std::string& enclave);
 // Every enclave of a full keystore: ground, the 12 end caps, listener.
 std::vector<std::string> all_enclaves();
 
@@ -57,8 +63,10 @@ bool may_subscribe(Role role, const TopicSpec& topic);
 // The unsigned documents (the keystore signs them with its CA). Validity in UTC,
 // "YYYY-MM-DDTHH:MM:SS". The subject is the certificate's, "CN=<enclave name>".
 std::string governance_xml();
-std::string permissions_xml(const std::string& enclave, Role role, const std::string& not_before,
-                            const std::string& not_after);
+std::string permissions_xml(const std::string& enclave, const std::string& not_before, const std::string& not_after);
+// The grant's <allow_rule> for `enclave` as this version writes it: a keystore whose
+// permissions.xml lacks it was made by another version (ground/keystore.hpp).
+std::string permission_rules(const std::string& enclave);
 std::string subject_name(const std::string& enclave);
 
 }  // namespace tensegrity::msgs

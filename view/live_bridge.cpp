@@ -17,6 +17,7 @@
 
 #include "ground/status.hpp"
 #include "msgs/dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "tensegrity_msgs/msg/TelemetryPubSubTypes.h"
 
@@ -28,7 +29,8 @@ namespace msg = tensegrity_msgs::msg::dds_;
 struct LiveReaders {
   class Listener final : public dds::DataReaderListener {
    public:
-    Listener(LiveBridge& bridge, bool telemetry) : bridge_(bridge), telemetry_(telemetry) {}
+    Listener(LiveBridge& bridge, const msgs::EndcapWriters& writers, bool telemetry)
+        : bridge_(bridge), writers_(writers), telemetry_(telemetry) {}
     void on_data_available(dds::DataReader* reader) override {
       if (telemetry_) {
         take<msg::Telemetry_>(reader, &LiveBridge::on_telemetry_sample);
@@ -45,15 +47,21 @@ struct LiveReaders {
       while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
         const std::int64_t now = LiveBridge::now_ns();
         if (!info.valid_data || sample.format_version() != msgs::kFormatVersion) continue;
+        // Only what its writer may say: end cap N's reports from end cap N's partition.
+        if (!writers_.vouches(info, endcap_of(sample))) continue;
         (bridge_.*fn)(&sample, now);
       }
     }
+    static int endcap_of(const msg::Telemetry_& t) { return t.endcap_id(); }
+    static int endcap_of(const msg::Heartbeat_& h) { return h.source(); }
     LiveBridge& bridge_;
+    const msgs::EndcapWriters& writers_;
     bool telemetry_;
   };
 };
 
 struct LiveBridge::Dds {
+  msgs::EndcapWriters writers;  // outlives the participant, which calls it
   dds::DomainParticipant* participant = nullptr;
   std::vector<std::unique_ptr<LiveReaders::Listener>> listeners;
   ~Dds() { msgs::delete_participant(participant); }
@@ -69,11 +77,11 @@ LiveBridge::LiveBridge(const sim::Robot& robot, const LiveOptions& options, Even
     : robot_(robot), options_(options), hub_(hub), dds_(std::make_unique<Dds>()) {
   // Through msgs::create_participant, like every participant of the project: the
   // same transport, QoS profiles and (where configured) security.
-  dds_->participant = msgs::create_participant(options.domain, "view", nullptr, options.enclave_dir);
-  dds::Subscriber* subscriber = dds_->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  dds_->participant = msgs::create_participant(options.domain, "view", nullptr, options.enclave_dir, &dds_->writers);
+  dds::Subscriber* subscriber = dds_->participant->create_subscriber(msgs::endcap_reports_qos());
   if (subscriber == nullptr) throw msgs::DdsError("view: cannot create a subscriber");
   for (bool telemetry : {true, false}) {
-    dds_->listeners.push_back(std::make_unique<LiveReaders::Listener>(*this, telemetry));
+    dds_->listeners.push_back(std::make_unique<LiveReaders::Listener>(*this, dds_->writers, telemetry));
     msgs::create_reader(*dds_->participant, *subscriber,
                         telemetry ? msgs::kTelemetryTopic : msgs::kEndcapHeartbeatTopic,
                         telemetry ? dds::TypeSupport(new msg::Telemetry_PubSubType())

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "firmware/comms/node_dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
@@ -55,7 +56,9 @@ void EndcapNode::start() {
   auto d = std::make_unique<Dds>();
   d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), config_.link_cut,
                                              config_.enclave_dir);
-  d->publisher = d->participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  // Reports go out in this end cap's own partition, the only one its identity may
+  // write in (msgs/endcap_writers.hpp); orders come in the default one.
+  d->publisher = d->participant->create_publisher(msgs::endcap_publisher_qos(config_.endcap_id));
   d->subscriber = d->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
   if (d->publisher == nullptr || d->subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
   d->policy_ack = d->writer(msgs::kPolicyAckTopic, dds::TypeSupport(new m::PolicyAck_PubSubType()));

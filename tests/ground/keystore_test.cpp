@@ -80,6 +80,28 @@ TEST_F(Keystore, AnIncompleteFolderIsRefusedNotFilledIn) {
   EXPECT_THROW(ensure_keystore(ks), KeystoreError);
 }
 
+// A keystore whose grants are not this version's (made before end caps published in
+// their own partitions, or tampered with) is named with the fix, never used: its end
+// caps could not create their writers.
+TEST_F(Keystore, AnotherVersionsPermissionsAreNamedWithTheFix) {
+  const fs::path ks = dir_ / "ks";
+  create_keystore(ks);
+  EXPECT_EQ(keystore_problem(ks), "");
+  const fs::path e3 = msgs::enclave_dir(ks, msgs::enclave_name(msgs::Role::endcap, 3));
+  const fs::path e5 = msgs::enclave_dir(ks, msgs::enclave_name(msgs::Role::endcap, 5));
+  fs::copy_file(e5 / "permissions.p7s", e3 / "permissions.p7s", fs::copy_options::overwrite_existing);
+  const std::string problem = keystore_problem(ks);
+  EXPECT_NE(problem.find((e3 / "permissions.p7s").string()), std::string::npos) << problem;
+  EXPECT_NE(problem.find("security init " + ks.string() + " --force"), std::string::npos) << problem;
+  EXPECT_FALSE(keystore_complete(ks));
+  try {
+    ensure_keystore(ks);
+    FAIL() << "a keystore with another version's grants was used";
+  } catch (const KeystoreError& e) {
+    EXPECT_NE(std::string(e.what()).find("endcap_03"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(Keystore, ProcessesRacingToCreateOneAllGetTheSameComplete) {
   const fs::path ks = dir_ / "race";
   std::atomic<int> created{0};

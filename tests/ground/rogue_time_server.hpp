@@ -16,6 +16,7 @@
 
 #include "ground/station.hpp"
 #include "msgs/dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"
 
 namespace tensegrity::test {
@@ -31,7 +32,8 @@ class RogueTimeServer final : public dds::DataReaderListener {
   explicit RogueTimeServer(int domain, const std::filesystem::path& enclave_dir = {}) {
     participant_ = msgs::create_participant(domain, "rogue_time_server", nullptr, enclave_dir);
     auto* pub = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-    auto* sub = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    // Where the end caps' requests are: every end cap's partition.
+    auto* sub = participant_->create_subscriber(msgs::endcap_reports_qos());
     namespace m = tensegrity_msgs::msg::dds_;
     writer_ = msgs::create_writer(*participant_, *pub, msgs::kTimeSyncReplyTopic,
                                   dds::TypeSupport(new m::TimeSyncReply_PubSubType()));

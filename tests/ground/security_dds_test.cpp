@@ -3,7 +3,8 @@
 // their enclaves of a keystore made by ground::create_keystore, and hosts with
 // other identities. Only the keystore's ground identity is heard and obeyed; an
 // unauthenticated participant, one of another CA, and one holding an end cap's
-// identity may not upload, start, clear a fault or answer a time sync. Domains 175-178.
+// identity may not upload, start, clear a fault or answer a time sync; an end cap's
+// identity may not speak for another end cap. Domains 175-179.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -17,7 +18,10 @@
 #include "ground/keystore.hpp"
 #include "ground/station.hpp"
 #include "ground/upload.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "msgs/security.hpp"
+#include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
+#include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 #include "tests/ground/rogue_time_server.hpp"
@@ -163,6 +167,55 @@ TEST_F(SecureDds, AnEndcapIdentityCannotGiveOrders) {
   EXPECT_THROW(station(kDomain, mixed), msgs::DdsError);
   // A listener (read-only) identity may watch but not command.
   EXPECT_THROW(station(kDomain, enclave("keystore", msgs::Role::listener)), msgs::DdsError);
+}
+
+// End cap 1's identity writes its reports only in end cap 1's partition (Fast DDS
+// refuses a writer anywhere else), and the ground refuses what it sends from there
+// under end cap 2's name: one end cap cannot ack, report or beat for another.
+TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
+  constexpr int kDomain = 179;
+  namespace dds = eprosima::fastdds::dds;
+  namespace m = tensegrity_msgs::msg::dds_;
+  start_nodes(kDomain);
+  auto ground = station(kDomain, enclave("keystore", msgs::Role::ground));
+  ASSERT_TRUE(ground->wait_for_endcaps(kThree, false, after_s(30)));
+  dds::DomainParticipant* impostor =
+      msgs::create_participant(kDomain, "impostor", nullptr, enclave("keystore", msgs::Role::endcap, 1));
+  struct Deleter {
+    dds::DomainParticipant* p;
+    ~Deleter() { msgs::delete_participant(p); }
+  } deleter{impostor};
+  for (const dds::PublisherQos& elsewhere : {msgs::endcap_publisher_qos(2), dds::PUBLISHER_QOS_DEFAULT}) {
+    dds::Publisher* pub = impostor->create_publisher(elsewhere);
+    ASSERT_NE(pub, nullptr);
+    EXPECT_THROW(msgs::create_writer(*impostor, *pub, msgs::kEndcapHeartbeatTopic,
+                                     dds::TypeSupport(new m::Heartbeat_PubSubType())),
+                 msgs::DdsError)
+        << "a writer outside end cap 1's partition";
+  }
+  dds::Publisher* own = impostor->create_publisher(msgs::endcap_publisher_qos(1));
+  dds::DataWriter* beats =
+      msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()));
+  dds::DataWriter* acks =
+      msgs::create_writer(*impostor, *own, msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
+  m::Heartbeat_ hb;
+  hb.format_version(msgs::kFormatVersion);
+  hb.source(2);
+  hb.seq(4'000'000'000U);  // far from any seq end cap 2 reaches in a test
+  m::CommandAck_ ack;
+  ack.format_version(msgs::kFormatVersion);
+  ack.endcap_id(2);
+  ack.seq(424242);
+  const std::int64_t deadline = after_s(20);
+  while (ground->impostor_samples() < 2 && Station::now_ns() < deadline) {
+    hb.seq(hb.seq() + 1);
+    beats->write(&hb);
+    acks->write(&ack);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_GE(ground->impostor_samples(), 2U) << "the impostor's samples never reached the ground";
+  for (const auto& a : ground->take_command_acks()) EXPECT_NE(a.seq(), 424242U) << "a forged ack was taken";
+  EXPECT_NE(ground->snapshot()[2].heartbeat.seq(), hb.seq()) << "end cap 2's status shows the impostor's heartbeat";
 }
 
 TEST_F(SecureDds, AMissingEnclaveFileIsNamed) {

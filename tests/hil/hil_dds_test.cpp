@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "ground/keystore.hpp"
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
 #include "tests/hil/hil_test_support.hpp"
@@ -60,8 +61,14 @@ TEST(HilDds, ASecuredRunRollsAsTheSimulatorDoes) {
   const double ref_m = in_process_m(policy_file(), duration_s);
 
   HilOptions o = options(duration_s, Provision::dds);
-  // One keystore for every run of this test on the machine, made on first use.
+  // One keystore for every run of this test on the machine, made on first use
+  // (remade when an older version made it: its grants would refuse the end caps).
   o.dds_keystore = std::filesystem::temp_directory_path() / "tensegrity-hil-test-keystore";
+  if (std::filesystem::exists(o.dds_keystore) && !ground::keystore_complete(o.dds_keystore)) {
+    ground::KeystoreOptions replace;
+    replace.replace = true;
+    ground::create_keystore(o.dds_keystore, replace);
+  }
   o.dds_discovery_timeout_s = 40.0;
   const HilResult r = run_hil(o);
   if (!r.ok) {

@@ -38,8 +38,8 @@ TEST(Security, OnlyTheGroundMayPublishOrders) {
 }
 
 TEST(Security, PermissionsDocumentsFollowTheTable) {
-  const std::string ground = permissions_xml("/tensegrity/ground", Role::ground, "2026-01-01T00:00:00", "2036-01-01T00:00:00");
-  const std::string endcap = permissions_xml("/tensegrity/endcap_03", Role::endcap, "2026-01-01T00:00:00", "2036-01-01T00:00:00");
+  const std::string ground = permissions_xml("/tensegrity/ground", "2026-01-01T00:00:00", "2036-01-01T00:00:00");
+  const std::string endcap = permissions_xml("/tensegrity/endcap_03", "2026-01-01T00:00:00", "2036-01-01T00:00:00");
   for (const TopicSpec& t : kAllTopics) {
     EXPECT_EQ(lists(publish_block(ground), t), t.writer == Writer::ground) << t.name;
     EXPECT_EQ(lists(publish_block(endcap), t), t.writer == Writer::endcap) << t.name;
@@ -47,8 +47,39 @@ TEST(Security, PermissionsDocumentsFollowTheTable) {
   }
   EXPECT_NE(endcap.find("<subject_name>CN=/tensegrity/endcap_03</subject_name>"), std::string::npos);
   EXPECT_NE(endcap.find("<default>DENY</default>"), std::string::npos);
-  const std::string listener = permissions_xml("/tensegrity/listener", Role::listener, "a", "b");
+  const std::string listener = permissions_xml("/tensegrity/listener", "a", "b");
   for (const TopicSpec& t : kAllTopics) EXPECT_FALSE(lists(publish_block(listener), t)) << t.name;
+  EXPECT_NE(permissions_xml("/tensegrity/endcap_03", "a", "b").find(permission_rules("/tensegrity/endcap_03")),
+            std::string::npos);
+  EXPECT_THROW(permissions_xml("/tensegrity/endcap_12", "a", "b"), DdsError);
+  EXPECT_THROW(permissions_xml("/other/ground", "a", "b"), DdsError);
+}
+
+// End cap 3's identity writes its reports in its partition and nowhere else (so it
+// cannot speak for end cap 5); orders travel in the default partition; the ground
+// and the listener read every end cap's partition.
+TEST(Security, PartitionsBindAnEndcapIdentityToItsId) {
+  const std::string endcap = permission_rules("/tensegrity/endcap_03");
+  EXPECT_NE(publish_block(endcap).find("<partitions><partition>endcap_03</partition></partitions>"), std::string::npos);
+  EXPECT_EQ(publish_block(endcap).find("<partition/>"), std::string::npos) << "no default partition for reports";
+  EXPECT_NE(subscribe_block(endcap).find("<partitions><partition/></partitions>"), std::string::npos);
+  const std::string ground = permission_rules("/tensegrity/ground");
+  EXPECT_NE(publish_block(ground).find("<partitions><partition/></partitions>"), std::string::npos);
+  EXPECT_NE(subscribe_block(ground).find("<partitions><partition>endcap_*</partition></partitions>"),
+            std::string::npos);
+  const std::string listener = permission_rules("/tensegrity/listener");
+  EXPECT_NE(subscribe_block(listener).find("<partition/><partition>endcap_*</partition>"), std::string::npos);
+  EXPECT_NE(permission_rules("/tensegrity/endcap_05"), endcap);
+}
+
+TEST(Security, EnclaveIdentities) {
+  EXPECT_EQ(identity_of("/tensegrity/ground").role, Role::ground);
+  EXPECT_EQ(identity_of("/tensegrity/listener").role, Role::listener);
+  const Identity e = identity_of("/tensegrity/endcap_11");
+  EXPECT_EQ(e.role, Role::endcap);
+  EXPECT_EQ(e.endcap_id, 11);
+  EXPECT_THROW(identity_of("/tensegrity/endcap_3"), DdsError);
+  EXPECT_THROW(identity_of(""), DdsError);
 }
 
 TEST(Security, GovernanceRefusesTheUnauthenticated) {

@@ -20,6 +20,7 @@
 
 #include "hil/dds_domain.hpp"
 #include "msgs/dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/TelemetryPubSubTypes.h"
 #include "view/csv_table.hpp"
 #include "view/live_bridge.hpp"
@@ -103,9 +104,15 @@ TEST(LiveBridge, HasNoWriterAndForwardsTelemetryToThePage) {
   Discovery discovery;
   dds::DomainParticipant* peer = msgs::create_participant(lease.domain(), "view-test-peer");
   peer->set_listener(&discovery);
-  dds::Publisher* publisher = peer->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  // End cap 3's reports come from end cap 3's partition; an impostor writing from
+  // end cap 5's partition claims to be end cap 3.
+  dds::Publisher* publisher = peer->create_publisher(msgs::endcap_publisher_qos(3));
+  dds::Publisher* impostor_publisher = peer->create_publisher(msgs::endcap_publisher_qos(5));
   dds::DataWriter* writer = msgs::create_writer(*peer, *publisher, msgs::kTelemetryTopic,
                                                 dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
+  dds::DataWriter* impostor = msgs::create_writer(
+      *peer, *impostor_publisher, msgs::kTelemetryTopic,
+      dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
   const sim::Robot robot = sim::load_robot(sim::default_robot_path());
   EventHub hub;
   std::uint64_t cursor = hub.head();
@@ -130,11 +137,19 @@ TEST(LiveBridge, HasNoWriterAndForwardsTelemetryToThePage) {
     t.host_time_ns(LiveBridge::now_ns());
     t.motor_count(2);
     t.tension_n() = std::array<double, 4>{123.0, 45.0, 0.0, 0.0};
+    tensegrity_msgs::msg::dds_::Telemetry_ forged = t;
+    forged.seq(99);
     std::string got;
     while (got.find("event: telemetry") == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+      impostor->write(&forged);
       writer->write(&t);
       got += hub.take(&cursor, 200, &skipped);
     }
+    for (int i = 0; i < 5; ++i) {
+      impostor->write(&forged);
+      got += hub.take(&cursor, 100, &skipped);
+    }
+    EXPECT_EQ(got.find("\"seq\":99"), std::string::npos) << "the view showed end cap 5's writer speaking for end cap 3";
     const std::vector<int> cables = robot.cables_of(3);
     const std::string expected_cables =
         "\"cables\":[" + std::to_string(cables[0]) + "," + std::to_string(cables[1]) + "],\"tension_n\":[123,45]";

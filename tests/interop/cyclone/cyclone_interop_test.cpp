@@ -14,6 +14,7 @@
 #include <string>
 
 #include "msgs/dds.hpp"
+#include "msgs/endcap_writers.hpp"
 #include "tests/ground/subprocess.hpp"
 
 namespace tensegrity::interop {
@@ -74,6 +75,9 @@ void expect_same_names_as_fast_dds(const std::string& out) {
     ASSERT_EQ(cyclone.count(spec.name), 1U) << spec.name;
     EXPECT_EQ(cyclone[spec.name], spec.type) << spec.name;
   }
+  const auto partition = lines(out, std::regex(R"(PARTITION reads=(\S+))"));
+  ASSERT_EQ(partition.size(), 1U) << out;
+  EXPECT_EQ(partition[0][1], msgs::kEveryEndcapPartition);
 }
 
 TEST_F(CycloneInterop, CyclonePeerReceivesTheFastDdsEndcapsTelemetry) {

@@ -74,6 +74,10 @@ dds_entity_t CycloneParticipant::writer(const CycloneTopic& t) {
 
 dds_entity_t CycloneParticipant::reader(const CycloneTopic& t) {
   const QosPtr qos = make_qos(t.profile, false);
+  // The peer plays the ground: what it reads, the end caps write, each in its own
+  // partition (msgs/endcap_writers.hpp). Cyclone gives the reader's implicit
+  // subscriber this QoS, and matches the pattern as Fast DDS does.
+  dds_qset_partition1(qos.get(), kEndcapReportsPartition);
   const dds_entity_t r = dds_create_reader(participant_, topic(t), qos.get(), nullptr);
   if (r < 0) throw CycloneError(failed(std::string("cannot create reader on ") + t.name, r));
   return r;

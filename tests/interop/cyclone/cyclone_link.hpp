@@ -37,6 +37,10 @@ inline const CycloneTopic kPolicyAckTopic{"rt/tensegrity/policy_ack", &tensegrit
 inline const CycloneTopic kTelemetryTopic{"rt/tensegrity/telemetry", &tensegrity_msgs_msg_dds__Telemetry__desc,
                                           Profile::stream};
 
+// Where the end caps write what the peer reads, as msgs::kEveryEndcapPartition
+// (checked by the test: the peer prints it).
+inline constexpr const char* kEndcapReportsPartition = "endcap_*";
+
 class CycloneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;

@@ -54,6 +54,7 @@ Peer::Peer(int domain, std::uint16_t mask) : participant_(domain), mask_(mask) {
   for (const CycloneTopic* t : {&kTelemetryTopic, &kPolicyAckTopic, &kPolicyTableTopic}) {
     std::printf("TOPIC name=%s type=%s\n", t->name, t->descriptor->m_typename);
   }
+  std::printf("PARTITION reads=%s\n", kEndcapReportsPartition);
   started_ns_ = now_ns();
 }
 

@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "msgs/endcap_writers.hpp"
+
+#include <cstdio>
+
+#include "msgs/dds.hpp"
+#include "msgs/security.hpp"
+
+namespace tensegrity::msgs {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace {
+constexpr std::string_view kPrefix = "endcap_";
+}  // namespace
+
+std::string endcap_partition(int endcap_id) {
+  if (endcap_id < 0 || endcap_id >= kMaxEndcaps) {
+    throw DdsError("end cap id " + std::to_string(endcap_id) + ": expected 0.." + std::to_string(kMaxEndcaps - 1));
+  }
+  char name[16];
+  std::snprintf(name, sizeof name, "endcap_%02d", endcap_id);
+  return name;
+}
+
+int endcap_of_partition(std::string_view partition) {
+  if (partition.size() != kPrefix.size() + 2 || partition.substr(0, kPrefix.size()) != kPrefix) return -1;
+  const char tens = partition[kPrefix.size()], ones = partition[kPrefix.size() + 1];
+  if (tens < '0' || tens > '9' || ones < '0' || ones > '9') return -1;
+  const int id = (tens - '0') * 10 + (ones - '0');
+  return id < kMaxEndcaps ? id : -1;
+}
+
+dds::PublisherQos endcap_publisher_qos(int endcap_id) {
+  dds::PublisherQos qos = dds::PUBLISHER_QOS_DEFAULT;
+  qos.partition().push_back(endcap_partition(endcap_id).c_str());
+  return qos;
+}
+
+dds::SubscriberQos endcap_reports_qos() {
+  dds::SubscriberQos qos = dds::SUBSCRIBER_QOS_DEFAULT;
+  qos.partition().push_back(kEveryEndcapPartition);
+  return qos;
+}
+
+void EndcapWriters::on_publisher_discovery(dds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) {
+  const rtps::GUID_t guid = info.info.guid();
+  std::lock_guard lock(mutex_);
+  if (info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER) {
+    endcap_of_writer_.erase(guid);
+    return;
+  }
+  // Discovered or changed QoS: what its partitions say now.
+  const auto& partitions = info.info.m_qos.m_partition;
+  int endcap = -1;
+  if (partitions.size() == 1) endcap = endcap_of_partition(partitions.begin()->name());
+  endcap_of_writer_[guid] = endcap;
+}
+
+int EndcapWriters::endcap_of(const dds::SampleInfo& info) const {
+  std::lock_guard lock(mutex_);
+  const auto it = endcap_of_writer_.find(info.sample_identity.writer_guid());
+  return it == endcap_of_writer_.end() ? -1 : it->second;
+}
+
+}  // namespace tensegrity::msgs
