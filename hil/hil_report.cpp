@@ -99,8 +99,9 @@ std::string summary_text(const HilResult& r) {
     } else {
       std::snprintf(phase, sizeof phase, "%8s", "-");
     }
-    std::snprintf(line, sizeof line, "%7d  %-20s  %s  %9d/%-4d  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n",
-                  e.endcap, e.fault.c_str(), phase, e.host_losses, e.host_returns,
+    std::snprintf(line, sizeof line, "%7d  %-20s  %s  %9llu/%-4llu  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n",
+                  e.endcap, e.fault.c_str(), phase, static_cast<unsigned long long>(e.host_losses),
+                  static_cast<unsigned long long>(e.host_returns),
                   static_cast<unsigned long long>(e.overruns), static_cast<unsigned long long>(e.rx_drops),
                   static_cast<unsigned long long>(e.bus.rx_frames), static_cast<unsigned long long>(e.bus.tx_frames),
                   static_cast<unsigned long long>(e.bus.injected_drops),

@@ -26,22 +26,6 @@ namespace tensegrity::hil {
 
 namespace {
 
-template <typename T>
-T stat_or(const nlohmann::json& j, const char* key, T fallback) {
-  if (!j.is_object() || !j.contains(key)) return fallback;
-  try {
-    return j.at(key).get<T>();
-  } catch (const std::exception&) {
-    return fallback;
-  }
-}
-
-int count_lines(const std::string& text, const std::string& needle) {
-  int n = 0;
-  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
-  return n;
-}
-
 // The table phase of every end cap still playing, from its --stats-json "table":
 // lockstep, the table time at the last SYNC (the same SYNC for all); real time,
 // the CLOCK_MONOTONIC instant of table time 0. Offsets are taken modulo the period
@@ -51,21 +35,14 @@ void phase_offsets(std::vector<EndcapSummary>& endcaps, const std::vector<Endcap
   std::vector<std::pair<std::size_t, double>> marks;  // (index, seconds)
   double period_s = 0.0;
   for (std::size_t i = 0; i < reports.size(); ++i) {
-    const nlohmann::json& stats = reports[i].stats;
-    if (!stats.is_object() || !stats.contains("table") || !stats["table"].is_object()) continue;
-    const nlohmann::json& t = stats["table"];
-    try {
-      period_s = t.at("period_s").get<double>();
-      double mark = 0.0;
-      if (mode == StepperMode::lockstep) {
-        mark = static_cast<double>(t.at("table_time_ns").get<std::int64_t>()) * 1e-9;
-      } else {
-        mark = static_cast<double>(t.at("loop_clock_origin_ns").get<std::int64_t>() +
-                                   t.at("origin_loop_ns").get<std::int64_t>()) * 1e-9;
-      }
-      marks.emplace_back(i, mark);
-    } catch (const std::exception&) {
-      continue;  // an end cap from another build: no phase
+    const auto& stats = reports[i].stats;
+    if (!stats || !stats->final || !stats->table) continue;  // not playing, or killed
+    const fw::app::TablePhase& t = *stats->table;
+    period_s = t.period_s;
+    if (mode == StepperMode::lockstep) {
+      marks.emplace_back(i, static_cast<double>(t.table_time_ns) * 1e-9);
+    } else if (t.loop_clock_origin_ns) {
+      marks.emplace_back(i, static_cast<double>(*t.loop_clock_origin_ns + t.origin_loop_ns) * 1e-9);
     }
   }
   if (marks.empty() || !(period_s > 0.0)) return;
@@ -259,24 +236,29 @@ EndcapSummary summarize(const EndcapProcessReport& r, const RunParts& parts) {
   s.exit_status = r.exit_status;
   s.cpu_s = r.cpu_s;
   s.restarts = r.restarts;
-  s.cycles = stat_or<std::uint64_t>(r.stats, "cycles", 0);
-  s.overruns = stat_or<std::uint64_t>(r.stats, "overruns", 0);
-  s.rx_drops = stat_or<std::uint64_t>(r.stats, "rx_drops", 0);
-  s.syncs = stat_or<std::uint64_t>(r.stats, "syncs_received", 0);
-  s.send_failures = stat_or<std::uint64_t>(r.stats, "send_failures", 0);
-  s.fault = stat_or<std::string>(r.stats, "fault", "unknown (no stats)");
-  s.bring_up = stat_or<std::string>(r.stats, "bring_up", "");
+  if (r.stats) {
+    s.cycles = r.stats->cycles;
+    s.overruns = r.stats->overruns;
+    s.rx_drops = r.stats->rx_drops;
+    s.syncs = r.stats->syncs_received;
+    s.send_failures = r.stats->send_failures;
+    s.fault = r.stats->fault;
+    s.bring_up = r.stats->bring_up;
+  } else {
+    s.fault = r.stats_error.empty() ? "unknown (no stats)" : "unknown (" + r.stats_error + ")";
+  }
+  fw::app::LinkEvents link = r.earlier_link;
+  if (r.stats) link += r.stats->link;
+  s.host_losses = link.host_losses;
+  s.host_returns = link.host_returns;
+  s.link_cuts = link.link_cuts;
+  s.loop_stalls = link.loop_stalls;
   if (parts.hub) s.bus = parts.hub->counters(r.endcap);
   if (static_cast<std::size_t>(r.endcap) < parts.devices_at_end.size()) {
     s.devices = parts.devices_at_end[static_cast<std::size_t>(r.endcap)];
   } else if (parts.stepper) {
     s.devices = parts.stepper->devices(r.endcap).summary();  // the run ended early
   }
-  const std::string log = parts.launcher->log_text(r.endcap);
-  s.host_losses = count_lines(log, "host LOST");
-  s.host_returns = count_lines(log, "host back");
-  s.link_cuts = count_lines(log, "DDS link CUT");
-  s.loop_stalls = count_lines(log, "control loop STALLED");
   return s;
 }
 

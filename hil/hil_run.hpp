@@ -82,11 +82,12 @@ struct EndcapSummary {
   // table times at the last SYNC; real time: CLOCK_MONOTONIC instants of table time 0.
   bool playing = false;
   double phase_offset_s = 0.0;
-  // From its log: host losses seen, DDS link cuts (fault injection).
-  int host_losses = 0;
-  int host_returns = 0;
-  int link_cuts = 0;
-  int loop_stalls = 0;  // the DDS node withheld its heartbeat: the control loop stood still
+  // From its stats (every incarnation): host losses seen, DDS link cuts (fault
+  // injection), loop stalls (the DDS node withheld its heartbeat).
+  std::uint64_t host_losses = 0;
+  std::uint64_t host_returns = 0;
+  std::uint64_t link_cuts = 0;
+  std::uint64_t loop_stalls = 0;
 };
 
 struct HilResult {

@@ -12,11 +12,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
 
+#include "firmware/app/endcap_stats.hpp"
 #include "firmware/core/limits.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 #include "hil/provisioner.hpp"
@@ -44,7 +45,12 @@ struct EndcapProcessReport {
   int exit_status = -1;    // exit code, or -signal
   double cpu_s = 0.0;      // user + system, read from /proc/PID/stat before the stop
   std::uint64_t restarts = 0;
-  nlohmann::json stats;    // the program's --stats-json (its last run), null if absent
+  // The program's --stats-json of its last incarnation (final, or the last
+  // once-a-second snapshot of one that was killed); absent if none was readable.
+  std::optional<fw::app::EndcapStats> stats;
+  std::string stats_error;  // why not, when a file was there
+  // The link's events of the incarnations before it (killed by a fault scenario).
+  fw::app::LinkEvents earlier_link;
 };
 
 class ProcessLauncher final : public EndcapProcesses {
@@ -90,9 +96,11 @@ class ProcessLauncher final : public EndcapProcesses {
     double cpu_before_s = 0.0;  // CPU of earlier (killed) incarnations
     std::uint64_t restarts = 0;
     std::filesystem::path config, log, stats;
+    std::vector<std::filesystem::path> earlier_stats;  // each restart's predecessor's
   };
   void spawn(int endcap, bool restart);
   void reap(int endcap, bool block);
+  static void read_stats(const Slot& slot, EndcapProcessReport& report);
 
   LauncherConfig config_;
   Provisioner& provisioner_;

@@ -6,6 +6,8 @@
 
 #include <chrono>
 #include <cstring>
+#include <fstream>
+#include <string>
 
 #include "firmware/app/endcap_log.hpp"
 #include "firmware/app/policy_file.hpp"
@@ -27,6 +29,20 @@ void try_realtime_priority(std::thread& thread) {
   param.sched_priority = 80;
   const int rc = pthread_setschedparam(thread.native_handle(), SCHED_FIFO, &param);
   if (rc != 0) log_line("SCHED_FIFO not available (%s): loop runs at normal priority", std::strerror(rc));
+}
+
+long vm_rss_kb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+TimingStats timing_stats(const TimingSummary& t) {
+  return {t.count, static_cast<double>(t.p50_ns) * 1e-3, static_cast<double>(t.p99_ns) * 1e-3,
+          static_cast<double>(t.max_ns) * 1e-3};
 }
 
 }  // namespace
@@ -174,8 +190,56 @@ void Endcap::activate() {
 void Endcap::housekeeping() {
   AppEvent event;
   while (loop_->pop_event(event)) log_event(event);
-  LoopStatus s;
-  if (loop_->read_status(s)) log_status(s);
+  if (loop_->read_status(last_status_)) log_status(last_status_);
+  // At once, then once a second: the counts as of the loop's last status line, the
+  // link's events as they are now.
+  const auto now = std::chrono::steady_clock::now();
+  if (!options_.stats_path.empty() && now >= next_stats_write_) {
+    next_stats_write_ = now + std::chrono::seconds(1);
+    if (!write_stats(options_.stats_path, stats())) log_line("could not write %s", options_.stats_path.c_str());
+  }
+}
+
+LinkEvents Endcap::link_events() const { return node_ ? node_->link_events() : LinkEvents{}; }
+
+EndcapStats Endcap::stats() const {
+  EndcapStats out;
+  out.final = state_ != State::active;
+  out.endcap = config_.endcap_id;
+  out.mode = to_string(config_.mode);
+  out.rate_hz = config_.loop_rate_hz;
+  out.vm_rss_kb = vm_rss_kb();
+  out.link = link_events();
+  if (!loop_) return out;
+  // Active: the loop thread owns its status; read what it last published.
+  const LoopStatus& s = out.final ? loop_->status() : last_status_;
+  out.cycles = s.cycles;
+  out.overruns = s.overruns;
+  out.stalls = s.stalls;
+  out.late_wakeups = s.late_wakeups;
+  out.syncs_received = s.syncs_received;
+  out.send_failures = s.send_failures;
+  out.rx_drops = s.rx_drops;
+  out.drain_limited_cycles = s.drain_limited_cycles;
+  out.fault = core::describe(s.fault);
+  out.bring_up = canopen::to_string(s.bring_up);
+  if (!out.final) return out;
+  const ControlLoop& loop = *loop_;
+  out.fault = core::describe(loop.controller().fault());
+  out.bring_up = canopen::to_string(loop.master().bring_up_step());
+  out.cycle = timing_stats(loop.cycle_histogram().summary());
+  out.wakeup_latency = timing_stats(loop.wakeup_histogram().summary());
+  const core::EndcapController& ctl = loop.controller();
+  if (ctl.mode() == core::Mode::running) {
+    TablePhase t;
+    t.period_s = ctl.active_table().period_s;
+    t.loop_time_ns = s.time_ns;
+    t.table_time_ns = ctl.table_time_ns(s.time_ns);
+    t.origin_loop_ns = s.time_ns - t.table_time_ns;
+    if (config_.mode == LoopMode::realtime) t.loop_clock_origin_ns = loop.clock_origin_ns();
+    out.table = t;
+  }
+  return out;
 }
 
 void Endcap::run(const std::atomic<bool>& stop) {

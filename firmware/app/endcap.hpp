@@ -8,6 +8,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -17,6 +18,7 @@
 
 #include "firmware/app/config.hpp"
 #include "firmware/app/control_loop.hpp"
+#include "firmware/app/endcap_stats.hpp"
 #include "firmware/app/host_link.hpp"
 #include "firmware/app/policy_store.hpp"
 #include "firmware/hal/can_bus.hpp"
@@ -44,6 +46,7 @@ struct EndcapOptions {
   bool insecure = false;           // --insecure: DDS without security, explicitly
   const std::atomic<bool>* link_cut = nullptr;  // --dds-cut-signals
   const std::atomic<bool>* hang_loop = nullptr;  // --hang-loop-signal (HIL tests only)
+  std::filesystem::path stats_path;  // --stats-json: a snapshot every second while running
 };
 
 // The identity `endcap --policy FILE` stores with the file's table: named after
@@ -65,6 +68,10 @@ class Endcap {
   void run(const std::atomic<bool>& stop);
   void deactivate() noexcept;
 
+  // What --stats-json holds: while active, a snapshot from the loop's last published
+  // status; once deactivated, the final report (timing, table phase).
+  EndcapStats stats() const;
+
   State state() const { return state_; }
   const EndcapAppConfig& config() const { return config_; }
   const ControlLoop& loop() const { return *loop_; }
@@ -74,6 +81,7 @@ class Endcap {
   void start_host_link();
   std::filesystem::path enclave_dir() const;
   void housekeeping();
+  LinkEvents link_events() const;
 
   EndcapOptions options_;
   State state_ = State::unconfigured;
@@ -91,6 +99,8 @@ class Endcap {
   // The loop's progress, one per pass (a lockstep wait included): the DDS node's watchdog.
   std::atomic<std::uint64_t> loop_progress_{0};
   std::thread loop_thread_;
+  LoopStatus last_status_{};  // the newest the loop published (housekeeping thread)
+  std::chrono::steady_clock::time_point next_stats_write_{};
 };
 
 }  // namespace tensegrity::fw::app

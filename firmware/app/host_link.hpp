@@ -53,6 +53,23 @@ struct Telemetry {
   std::uint64_t overruns = 0;
 };
 
+// What the link saw happen, counted (the log says it in words): the host's heartbeat
+// lost and back, the link cut by fault injection, the control loop seen stalled by
+// the node's watchdog. Read by the housekeeping thread for --stats-json.
+struct LinkEvents {
+  std::uint64_t host_losses = 0;
+  std::uint64_t host_returns = 0;
+  std::uint64_t link_cuts = 0;
+  std::uint64_t loop_stalls = 0;
+  LinkEvents& operator+=(const LinkEvents& o) {
+    host_losses += o.host_losses;
+    host_returns += o.host_returns;
+    link_cuts += o.link_cuts;
+    loop_stalls += o.loop_stalls;
+    return *this;
+  }
+};
+
 class HostLink {
  public:
   virtual ~HostLink() = default;
@@ -67,6 +84,7 @@ class HostLink {
   // in the cycle after it changes.
   virtual std::uint32_t emergency_stops() const noexcept { return 0; }
   virtual std::uint32_t host_loss_stops() const noexcept { return 0; }
+  virtual LinkEvents link_events() const noexcept { return {}; }
 };
 
 // No host yet: tables come from --policy and the store, start from --start-on-boot.

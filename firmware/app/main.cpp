@@ -8,17 +8,14 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "firmware/app/endcap.hpp"
 #include "firmware/app/endcap_log.hpp"
 
 namespace app = tensegrity::fw::app;
-namespace core = tensegrity::core;
 
 namespace {
 
@@ -35,67 +32,19 @@ extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1)
 std::atomic<bool> g_hang_loop{false};
 extern "C" void on_hang_signal(int) { g_hang_loop.store(true); }
 
-long vm_rss_kb() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
-double us(std::int64_t ns) { return static_cast<double>(ns) * 1e-3; }
-
-nlohmann::json summary_json(const app::TimingSummary& s) {
-  return {{"count", s.count}, {"p50_us", us(s.p50_ns)}, {"p99_us", us(s.p99_ns)}, {"max_us", us(s.max_ns)}};
-}
-
-// The exit line and --stats-json: where the table stood at the last cycle, so a
-// launcher can check that end caps play in phase (table time at the last loop
-// time and, in real time, the CLOCK_MONOTONIC reading of loop time 0).
+// The exit line, and the final --stats-json (endcap_stats.hpp): the run's timing
+// and where the table stood at the last cycle, so a launcher can check that end
+// caps play in phase.
 void report_exit(const app::Endcap& endcap, const std::string& stats_path) {
-  const app::ControlLoop& loop = endcap.loop();
-  const app::LoopStatus& s = loop.status();
-  const app::TimingSummary cycle = loop.cycle_histogram().summary();
-  const app::TimingSummary wake = loop.wakeup_histogram().summary();
-  const long rss_kb = vm_rss_kb();
+  const app::EndcapStats s = endcap.stats();
+  const app::TimingStats cycle = s.cycle.value_or(app::TimingStats{});
+  const app::TimingStats wake = s.wakeup_latency.value_or(app::TimingStats{});
   app::log_line("exit: cycles %llu overruns %llu late wakeups %llu; cycle p50 %.1f us p99 %.1f us max %.1f us; "
                 "wake-up latency p50 %.1f us p99 %.1f us; VmRSS %ld kB",
                 static_cast<unsigned long long>(s.cycles), static_cast<unsigned long long>(s.overruns),
-                static_cast<unsigned long long>(s.late_wakeups), us(cycle.p50_ns), us(cycle.p99_ns), us(cycle.max_ns),
-                us(wake.p50_ns), us(wake.p99_ns), rss_kb);
-  if (stats_path.empty()) return;
-  nlohmann::json table_state = nullptr;
-  const core::EndcapController& ctl = loop.controller();
-  if (ctl.mode() == core::Mode::running) {
-    table_state = {{"period_s", ctl.active_table().period_s},
-                   {"loop_time_ns", s.time_ns},
-                   {"table_time_ns", ctl.table_time_ns(s.time_ns)},
-                   {"origin_loop_ns", s.time_ns - ctl.table_time_ns(s.time_ns)}};
-    if (endcap.config().mode == app::LoopMode::realtime) table_state["loop_clock_origin_ns"] = loop.clock_origin_ns();
-  }
-  const nlohmann::json stats = {
-      {"table", table_state},
-      {"endcap", endcap.config().endcap_id},
-      {"mode", to_string(endcap.config().mode)},
-      {"rate_hz", endcap.config().loop_rate_hz},
-      {"cycles", s.cycles},
-      {"overruns", s.overruns},
-      {"stalls", s.stalls},
-      {"late_wakeups", s.late_wakeups},
-      {"syncs_received", s.syncs_received},
-      {"send_failures", s.send_failures},
-      {"rx_drops", s.rx_drops},
-      {"drain_limited_cycles", s.drain_limited_cycles},
-      {"cycle", summary_json(cycle)},
-      {"wakeup_latency", summary_json(wake)},
-      {"fault", core::describe(ctl.fault())},
-      {"bring_up", to_string(loop.master().bring_up_step())},
-      {"vm_rss_kb", rss_kb},
-  };
-  std::ofstream out(stats_path);
-  out << stats.dump(2) << "\n";
-  if (!out) app::log_line("could not write %s", stats_path.c_str());
+                static_cast<unsigned long long>(s.late_wakeups), cycle.p50_us, cycle.p99_us, cycle.max_us,
+                wake.p50_us, wake.p99_us, s.vm_rss_kb);
+  if (!stats_path.empty() && !app::write_stats(stats_path, s)) app::log_line("could not write %s", stats_path.c_str());
 }
 
 }  // namespace
@@ -112,7 +61,9 @@ int main(int argc, char** argv) {
                  "policy file (tensegrity-policy/1); this end cap's share is validated and stored (with its "
                  "identity, file:NAME v0) and loaded");
   cli.add_flag("--start-on-boot", o.start_on_boot, "start playing the table as soon as the drives are enabled");
-  cli.add_option("--stats-json", stats_path, "write loop timing and memory to this file at exit");
+  cli.add_option("--stats-json", stats_path,
+                 "write the run's statistics (tensegrity-endcap-stats/1) to this file: a snapshot every second, "
+                 "the full report at exit");
   cli.add_option("--duration-s", o.duration_s, "exit after this many seconds (0: run until SIGINT/SIGTERM)");
   // Accepted in builds without DDS too (where they change nothing), so that
   // launchers and tests pass the same arguments to every build.
@@ -145,6 +96,7 @@ int main(int argc, char** argv) {
   o.config_path = config_path;
   o.keystore = keystore;
   o.policy_path = policy_path;
+  o.stats_path = stats_path;
 
   app::Endcap endcap(o);
   try {

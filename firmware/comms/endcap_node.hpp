@@ -63,6 +63,8 @@ class EndcapNode final : public app::HostLink {
   void publish(const app::Telemetry& telemetry) noexcept override;
   std::uint32_t emergency_stops() const noexcept override { return estops_.load(std::memory_order_acquire); }
   std::uint32_t host_loss_stops() const noexcept override { return host_loss_stops_.load(std::memory_order_acquire); }
+  // Any thread (the program's housekeeping reads it for --stats-json).
+  app::LinkEvents link_events() const noexcept override;
 
   // For logs and tests (any thread).
   ActivePolicy active_policy() const;
@@ -175,6 +177,8 @@ class EndcapNode final : public app::HostLink {
   ActivePolicy active_;
   TimeSyncClient sync_;
   std::atomic<bool> host_lost_{false};
+  // What the log says in words, counted (written by the node thread only).
+  std::atomic<std::uint64_t> host_losses_{0}, host_returns_{0}, link_cuts_{0}, loop_stalls_{0};
 
   std::mutex wake_mutex_;
   std::condition_variable wake_cv_;

@@ -37,6 +37,7 @@ void EndcapNode::report_link_cut() {
   const bool cut = config_.link_cut->load(std::memory_order_relaxed);
   if (cut == link_was_cut_) return;
   link_was_cut_ = cut;
+  if (cut) link_cuts_.fetch_add(1, std::memory_order_relaxed);
   log("DDS link %s (fault injection)", cut ? "CUT" : "restored");
 }
 
@@ -44,6 +45,7 @@ void EndcapNode::check_host_loss(std::int64_t now) {
   const bool lost = host_seen_ && now - last_host_heartbeat_ns_ > std::llround(config_.host_timeout_s * 1e9);
   if (lost == host_lost_.load()) return;
   host_lost_.store(lost);
+  (lost ? host_losses_ : host_returns_).fetch_add(1, std::memory_order_relaxed);
   log("host %s (configured action: %s)", lost ? "LOST: no heartbeat" : "back", to_string(config_.host_loss));
   // A counter the loop reads every cycle, like the estop: never refused by a full mailbox.
   if (lost && config_.host_loss == HostLossAction::stop) host_loss_stops_.fetch_add(1, std::memory_order_acq_rel);
@@ -62,10 +64,16 @@ bool EndcapNode::loop_alive(std::int64_t now) {
   if (progress == 0) return true;
   const bool stalled = now - loop_progress_ns_ > std::llround(config_.loop_stall_timeout_s * 1e9);
   if (stalled != loop_stall_reported_) {
+    if (stalled) loop_stalls_.fetch_add(1, std::memory_order_relaxed);
     log("control loop %s", stalled ? "STALLED: DDS heartbeat withheld" : "progressing again: DDS heartbeat resumed");
   }
   loop_stall_reported_ = stalled;
   return !stalled;
+}
+
+app::LinkEvents EndcapNode::link_events() const noexcept {
+  return {host_losses_.load(std::memory_order_relaxed), host_returns_.load(std::memory_order_relaxed),
+          link_cuts_.load(std::memory_order_relaxed), loop_stalls_.load(std::memory_order_relaxed)};
 }
 
 void EndcapNode::send_telemetry() {

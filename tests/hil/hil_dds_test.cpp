@@ -103,8 +103,8 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
   for (const auto& e : r.endcaps) {
-    EXPECT_EQ(e.link_cuts, 1) << "end cap " << e.endcap;
-    EXPECT_GE(e.host_losses, 1) << "end cap " << e.endcap << " never noticed the host was gone";
+    EXPECT_EQ(e.link_cuts, 1U) << "end cap " << e.endcap;
+    EXPECT_GE(e.host_losses, 1U) << "end cap " << e.endcap << " never noticed the host was gone";
     EXPECT_EQ(e.host_returns, e.host_losses) << "end cap " << e.endcap << " did not see the host come back";
     EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
   }
@@ -116,6 +116,21 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
   EXPECT_EQ(r.max_phase_offset_s, 0.0);
   std::printf("link cut, continue: %.3f m at the cut, %.3f m at the restore, %.3f m at the end (in-process %.3f m)\n",
               at_cut, at_restore, r.distance_m, ref_m);
+}
+
+// The counts travel in each end cap's --stats-json, and a killed program's last
+// snapshot is kept: end cap 4's link cut happened to the incarnation killed after
+// it, and the run's summary still has it.
+TEST(HilDds, AKilledEndcapsLinkEventsAreKept) {
+  HilOptions o = options(8.0, Provision::dds);
+  o.scenario.events = {link_event(0.5, FaultKind::cut_dds), link_event(4.0, FaultKind::restore_dds)};
+  for (const ScenarioEvent& e : kill_and_restart(4, 5.0, 5.5)) o.scenario.events.push_back(e);
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  for (const auto& e : r.endcaps) {
+    EXPECT_EQ(e.link_cuts, 1U) << "end cap " << e.endcap;
+    EXPECT_EQ(e.restarts, e.endcap == 4 ? 1U : 0U) << "end cap " << e.endcap;
+  }
 }
 
 TEST(HilDds, LinkCutWithStopStopsTheGait) {
@@ -131,8 +146,8 @@ TEST(HilDds, LinkCutWithStopStopsTheGait) {
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
   for (const auto& e : r.endcaps) {
-    EXPECT_EQ(e.link_cuts, 1) << "end cap " << e.endcap;
-    EXPECT_GE(e.host_losses, 1) << "end cap " << e.endcap;
+    EXPECT_EQ(e.link_cuts, 1U) << "end cap " << e.endcap;
+    EXPECT_GE(e.host_losses, 1U) << "end cap " << e.endcap;
     EXPECT_FALSE(e.playing) << "end cap " << e.endcap << " still playing after losing the host";
     EXPECT_EQ(e.fault, "none") << "a stop is not a fault: end cap " << e.endcap;
   }

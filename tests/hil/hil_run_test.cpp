@@ -65,7 +65,7 @@ TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
     // Not asserted: at full lockstep speed the emulator and the loops (real-time
     // priority) can starve the DDS threads on a loaded 2-core host long enough for
     // an end cap to call its host lost (docs/hil.md); the gait is open loop.
-    if (e.host_losses > 0) std::printf("end cap %d reported %d host loss(es)\n", e.endcap, e.host_losses);
+    if (e.host_losses > 0) std::printf("end cap %d reported %llu host loss(es)\n", e.endcap, static_cast<unsigned long long>(e.host_losses));
   }
   EXPECT_TRUE(child_pids().empty()) << "end-cap processes left behind";
   EXPECT_EQ(dds_shm_files(), shm_before) << "shared-memory files left in /dev/shm";

@@ -160,7 +160,7 @@ TEST(HilSupervision, HungLoopIsStoppedByItsDrivesAndSeenByTheHost) {
   expect_drives_stop_by_themselves(r, snap, 5, "hang_loop");
   if (dds) {
     EXPECT_TRUE(stalled_logged) << "the DDS node must withhold its heartbeat for a hung loop";
-    EXPECT_GE(r.endcaps.at(5).loop_stalls, 1);
+    EXPECT_GE(r.endcaps.at(5).loop_stalls, 1U);
   }
 }
 

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/app/endcap_stats.hpp"
 #include "firmware/app/policy_store.hpp"
 #include "firmware/drivers/pdo_codec.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
@@ -192,14 +193,26 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
   EXPECT_LE(max0, spool.counts_from_rest_length(0.9) + 1);
   EXPECT_GE(min1, spool.counts_from_rest_length(1.0) - 1);
 
+  // While it runs: a snapshot each second (what a killed end cap leaves behind).
+  const auto snapshot_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!std::filesystem::exists(dir / "stats.json") && std::chrono::steady_clock::now() < snapshot_deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const app::EndcapStats running = app::load_stats(dir / "stats.json");
+  EXPECT_FALSE(running.final);
+  EXPECT_EQ(running.endcap, 2);
+  EXPECT_FALSE(running.cycle.has_value()) << "timing is reported at exit";
   EXPECT_EQ(child.terminate(std::chrono::seconds(2)), 0);
-  std::ifstream stats_file(dir / "stats.json");
-  ASSERT_TRUE(stats_file) << "--stats-json written at exit";
-  const json stats = json::parse(stats_file);
-  EXPECT_GT(stats["cycles"].get<std::uint64_t>(), 100U);
-  EXPECT_EQ(stats["cycles"].get<std::uint64_t>(), stats["syncs_received"].get<std::uint64_t>())
-      << "lockstep: one cycle per SYNC";
-  EXPECT_EQ(stats["fault"], "none");
+  const app::EndcapStats stats = app::load_stats(dir / "stats.json");
+  EXPECT_TRUE(stats.final) << "--stats-json rewritten at exit";
+  EXPECT_EQ(stats.endcap, 2);
+  EXPECT_GT(stats.cycles, 100U);
+  EXPECT_GE(stats.cycles, running.cycles);
+  EXPECT_EQ(stats.cycles, stats.syncs_received) << "lockstep: one cycle per SYNC";
+  EXPECT_EQ(stats.fault, "none");
+  ASSERT_TRUE(stats.cycle.has_value());
+  EXPECT_GT(stats.cycle->count, 0U);
+  EXPECT_EQ(stats.link.host_losses, 0U) << "no DDS link in this run";
   // --policy FILE stored the table with its own identity, as one record.
   FileStorage storage(dir / "store");
   app::PolicyStore store(storage, 2, core::MotorLimits{});
