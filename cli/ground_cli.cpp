@@ -74,13 +74,17 @@ std::uint16_t parse_endcap_set(const std::string& text) {
   return mask;
 }
 
-std::unique_ptr<ground::Station> make_station(const GroundOptions& options, bool publish_heartbeat) {
+ground::StationOptions station_options(const GroundOptions& options, bool publish_heartbeat) {
   ground::StationOptions s;
   s.domain = options.domain >= 0 ? options.domain : msgs::domain_id();
   s.name = "tensegrity-cli";
   s.publish_heartbeat = publish_heartbeat;
   s.enclave_dir = tool_enclave(msgs::Role::ground, options.keystore, options.insecure);
-  return std::make_unique<ground::Station>(s);
+  return s;
+}
+
+std::unique_ptr<ground::Station> make_station(const GroundOptions& options, bool publish_heartbeat) {
+  return std::make_unique<ground::Station>(station_options(options, publish_heartbeat));
 }
 
 bool wait_for_endcaps(ground::Station& station, const GroundOptions& options, bool synced) {

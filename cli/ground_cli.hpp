@@ -34,6 +34,9 @@ void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure);
 void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_timeout_s);
 // "0-11", "3", "0,2,5-7" -> mask; throws CommandError(2) naming the bad part.
 std::uint16_t parse_endcap_set(const std::string& text);
+// What make_station builds (the enclave resolved once: a tool that rejoins makes
+// several stations from it).
+ground::StationOptions station_options(const GroundOptions& options, bool publish_heartbeat = true);
 std::unique_ptr<ground::Station> make_station(const GroundOptions& options, bool publish_heartbeat = true);
 // Waits (up to the timeout) for the addressed end caps' heartbeats so that a
 // command is not sent into discovery; returns false when some are missing.

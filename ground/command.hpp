@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +39,7 @@ struct CommandReport {
   CommandKind kind = CommandKind::stop;
   std::int64_t start_host_time_ns = 0;
   std::vector<EndcapCommandResult> results;
+  int rejoins = 0;  // send_command_rejoining: fresh participants it took
   bool all_accepted() const;
   std::vector<int> missing() const;  // addressed end caps that never acknowledged
 };
@@ -44,6 +47,20 @@ struct CommandReport {
 // `start_host_time_ns` (host clock, Station::now_ns) is used by start only.
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
                            const CommandOptions& options);
+
+// For a command that must land (the emergency stop): a secured participant's
+// handshake with an end cap now and then stalls for good in Fast DDS 2.9
+// (docs/security.md), and a fresh ground tool needs seconds to authenticate with
+// twelve. While end caps are missing and none has acknowledged for `stall_s`, the
+// station is replaced by a new one from `make_station` (a new participant,
+// handshakes afresh) and the command goes on until all acked or the deadline.
+struct RejoinOptions {
+  double stall_s = 4.0;
+  std::function<std::unique_ptr<Station>()> make_station;
+};
+CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandKind kind,
+                                     std::int64_t start_host_time_ns, const CommandOptions& options,
+                                     const RejoinOptions& rejoin);
 
 std::string format_command_report(const CommandReport& report);
 
