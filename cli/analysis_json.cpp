@@ -15,7 +15,8 @@ json groups_of(const std::vector<int>& labels, const std::vector<int>& leaf_orde
   int count = 0;
   for (const int l : labels) count = std::max(count, l + 1);
   std::vector<std::vector<int>> groups(static_cast<std::size_t>(count));
-  for (const int leaf : leaf_order) groups[static_cast<std::size_t>(labels[static_cast<std::size_t>(leaf)])].push_back(leaf);
+  for (const int leaf : leaf_order)
+    groups[static_cast<std::size_t>(labels[static_cast<std::size_t>(leaf)])].push_back(leaf);
   return groups;
 }
 
@@ -39,16 +40,23 @@ json muscles_json(const an::Analysis& a, double window_start_s) {
   for (const auto& r : a.robot) {
     if (r.time_s >= window_start_s) per_sample.push_back(r.power_mean_w);
   }
-  const std::size_t width = per_sample.size() > 1 ? static_cast<std::size_t>(std::lround(
-      1.0 / ((a.window_end_s - a.window_start_s) / static_cast<double>(per_sample.size() - 1)))) : 1;
+  const std::size_t width =
+      per_sample.size() > 1
+          ? static_cast<std::size_t>(
+                std::lround(1.0 / ((a.window_end_s - a.window_start_s) / static_cast<double>(per_sample.size() - 1))))
+          : 1;
   const auto smooth = an::moving_average(per_sample, width);
   const auto [lo, hi] = std::minmax_element(smooth.begin(), smooth.end());
-  return {{"rest_length_m", {{"min", rest_min}, {"max", rest_max}, {"mean_lowest", mean_lo}, {"mean_highest", mean_hi}}},
-          {"mean_stretch_m", stretch},
-          {"tension_n", {{"mean", tension}, {"peak", peak}}},
-          {"power_per_muscle_w", {{"mean", power}, {"lowest_muscle", power_lo}, {"highest_muscle", power_hi},
-                                  {"mean_over_1s_min", smooth.empty() ? 0.0 : *lo},
-                                  {"mean_over_1s_max", smooth.empty() ? 0.0 : *hi}}}};
+  return {
+      {"rest_length_m", {{"min", rest_min}, {"max", rest_max}, {"mean_lowest", mean_lo}, {"mean_highest", mean_hi}}},
+      {"mean_stretch_m", stretch},
+      {"tension_n", {{"mean", tension}, {"peak", peak}}},
+      {"power_per_muscle_w",
+       {{"mean", power},
+        {"lowest_muscle", power_lo},
+        {"highest_muscle", power_hi},
+        {"mean_over_1s_min", smooth.empty() ? 0.0 : *lo},
+        {"mean_over_1s_max", smooth.empty() ? 0.0 : *hi}}}};
 }
 
 json energy_json(const an::Analysis& a) {
@@ -62,8 +70,10 @@ json energy_json(const an::Analysis& a) {
     pe_max = std::max(pe_max, r.elastic_j);
     ++n;
   }
-  return {{"kinetic_mean_j", n ? ke_mean / static_cast<double>(n) : 0.0}, {"kinetic_max_j", ke_max},
-          {"elastic_min_j", pe_min}, {"elastic_max_j", pe_max}};
+  return {{"kinetic_mean_j", n ? ke_mean / static_cast<double>(n) : 0.0},
+          {"kinetic_max_j", ke_max},
+          {"elastic_min_j", pe_min},
+          {"elastic_max_j", pe_max}};
 }
 
 json rolling_json(const an::Analysis& a) {
@@ -84,8 +94,11 @@ json rolling_json(const an::Analysis& a) {
           {"face_cycle_match", a.cycle.match},
           {"revolutions", a.turning.revolutions()},
           {"turned_total_rad", a.turning.total_angle_rad},
-          {"slip_m_per_s", {{"mean", a.slip.mean_m_per_s}, {"median", a.slip.median_m_per_s},
-                            {"p95", a.slip.p95_m_per_s}, {"samples", a.slip.samples}}}};
+          {"slip_m_per_s",
+           {{"mean", a.slip.mean_m_per_s},
+            {"median", a.slip.median_m_per_s},
+            {"p95", a.slip.p95_m_per_s},
+            {"samples", a.slip.samples}}}};
 }
 
 }  // namespace
@@ -125,14 +138,14 @@ void print_analysis_summary(const json& j) {
   std::printf("  tension          mean %.1f N, peak %.1f N\n", j["tension_n"]["mean"].get<double>(),
               j["tension_n"]["peak"].get<double>());
   std::printf("  power per muscle mean %.2f W (muscles %.2f-%.2f W; 1 s mean %.2f-%.2f W)\n", p["mean"].get<double>(),
-              p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(),
-              p["mean_over_1s_min"].get<double>(), p["mean_over_1s_max"].get<double>());
+              p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(), p["mean_over_1s_min"].get<double>(),
+              p["mean_over_1s_max"].get<double>());
   std::printf("  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle), %.2f s from rotation\n",
               period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
               period["rotation"].get<double>());
   std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
-              r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(), r["face_sequence"].size(),
-              r["slip_m_per_s"]["median"].get<double>());
+              r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(),
+              r["face_sequence"].size(), r["slip_m_per_s"]["median"].get<double>());
   std::printf("  clusters         %zu (zero lag), %zu (phase aligned) at 1 - r <= %.2f\n",
               j["clusters"]["zero_lag"].size(), j["clusters"]["phase_aligned"].size(),
               j["clusters"]["cut_height"].get<double>());

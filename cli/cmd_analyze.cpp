@@ -127,8 +127,9 @@ void run_analyze(const AnalyzeArgs& args) {
 void add_analyze_command(CLI::App& app) {
   auto args = std::make_shared<AnalyzeArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "analyze", "Play a policy for one episode and write Figures 10-12 (rest lengths, tensions, energy, power, "
-                 "correlation and clustering of the signals) and the rolling evidence as CSV and PNG");
+      "analyze",
+      "Play a policy for one episode and write Figures 10-12 (rest lengths, tensions, energy, power, "
+      "correlation and clustering of the signals) and the rolling evidence as CSV and PNG");
   cmd->add_option("POLICY", args->policy, "Policy file to play (tensegrity-policy/1)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -41,9 +41,8 @@ void run_bench_sim(const BenchSimArgs& args) {
   std::vector<double> sorted = wall;
   std::sort(sorted.begin(), sorted.end());
   const double min = sorted.front();
-  const double median = sorted.size() % 2 == 1
-                            ? sorted[sorted.size() / 2]
-                            : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
+  const double median = sorted.size() % 2 == 1 ? sorted[sorted.size() / 2]
+                                               : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
   const double rtf = args.duration_s / median;
   if (args.json) {
     const nlohmann::json j = {{"benchmark", "sim"},
@@ -74,8 +73,12 @@ void add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchSimArgs>();
   CLI::App* sim_cmd = bench->add_subcommand("sim", "Benchmark policy, 60 s at dt 1 ms, N episodes on one thread");
   sim_cmd->add_option("--robot", args->robot, "Robot description")->check(CLI::ExistingFile);
-  sim_cmd->add_option("--episodes", args->episodes, "Episodes to time")->capture_default_str()->check(CLI::Range(1, 100000));
-  sim_cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  sim_cmd->add_option("--episodes", args->episodes, "Episodes to time")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  sim_cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
   sim_cmd->add_flag("--json", args->json, "Print one JSON object");
   sim_cmd->callback([args] { run_bench_sim(*args); });
   add_bench_evolve_command(*bench);

@@ -90,9 +90,13 @@ void add_bench_evolve_command(CLI::App& bench) {
   auto args = std::make_shared<BenchEvolveArgs>();
   CLI::App* cmd = bench.add_subcommand("evolve", "Episodes per second during evolution, per core and vs one thread");
   cmd->add_option("--robot", args->robot, "Robot description")->check(CLI::ExistingFile);
-  cmd->add_option("--episodes", args->episodes, "Episodes to run (50 per generation)")->capture_default_str()->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000}));
+  cmd->add_option("--episodes", args->episodes, "Episodes to run (50 per generation)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000}));
   cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
   cmd->add_flag("--json", args->json, "Print one JSON object");
   cmd->callback([args] { run_bench_evolve(*args); });
 }

@@ -143,7 +143,8 @@ nlohmann::json RunSampler::report(double dt_s) const {
           {"load_average_start", start_.load_average_1min},
           {"load_average_end", end_.load_average_1min},
           {"steal_s", steal_s},
-          {"steal_cpu_fraction", steal_s >= 0 && wall > 0 && cpus > 0 ? steal_s / (wall * static_cast<double>(cpus)) : -1.0}};
+          {"steal_cpu_fraction",
+           steal_s >= 0 && wall > 0 && cpus > 0 ? steal_s / (wall * static_cast<double>(cpus)) : -1.0}};
 }
 
 struct ModeResult {
@@ -221,8 +222,9 @@ nlohmann::json realtime_json(const ModeResult& m) {
           {"steps", r.stats.steps},
           {"late_steps", r.stats.late_steps},
           {"late_rate", rate},
-          {"late_definition", "a step the stepper began more than half a period (0.5 ms) after its absolute deadline "
-                              "(run start + k periods); a stall makes several steps in a row late: one episode"},
+          {"late_definition",
+           "a step the stepper began more than half a period (0.5 ms) after its absolute deadline "
+           "(run start + k periods); a stall makes several steps in a row late: one episode"},
           {"late_episodes", r.stats.lateness.late_episodes},
           {"missed_steps", r.stats.lateness.missed_steps},
           {"lateness_p50_s", 1e-9 * static_cast<double>(r.stats.lateness.p50_ns)},
@@ -239,8 +241,9 @@ nlohmann::json realtime_json(const ModeResult& m) {
 
 nlohmann::json platform_json(const hil::TimerProbeResult& p) {
   const hil::LatenessSummary& l = p.lateness;
-  return {{"what", "a thread that only paces like the real-time stepper (same priority, sleep then spin, "
-                   "absolute 1 ms deadlines), before the runs: the kernel's and hypervisor's share of lateness"},
+  return {{"what",
+           "a thread that only paces like the real-time stepper (same priority, sleep then spin, "
+           "absolute 1 ms deadlines), before the runs: the kernel's and hypervisor's share of lateness"},
           {"sched_fifo", p.sched_fifo},
           {"steps", l.steps},
           {"late_steps", l.late_steps},
@@ -259,11 +262,11 @@ void print_link(const nlohmann::json& link) {
 }
 
 void print_cpu(const nlohmann::json& c) {
-  std::printf("            CPU per simulated second %.3f s (emulator %.3f, stepper thread %.3f; end caps %.3f, %.4f each)\n",
-              c["cpu_s_per_sim_s"].get<double>(), c["emulator_cpu_s_per_sim_s"].get<double>(),
-              c["stepper_thread_cpu_s"].get<double>() / c["sim_s"].get<double>(),
-              c["endcaps_cpu_s_per_sim_s"].get<double>(),
-              c["endcap_cpu_mean_s"].get<double>() / c["sim_s"].get<double>());
+  std::printf(
+      "            CPU per simulated second %.3f s (emulator %.3f, stepper thread %.3f; end caps %.3f, %.4f each)\n",
+      c["cpu_s_per_sim_s"].get<double>(), c["emulator_cpu_s_per_sim_s"].get<double>(),
+      c["stepper_thread_cpu_s"].get<double>() / c["sim_s"].get<double>(), c["endcaps_cpu_s_per_sim_s"].get<double>(),
+      c["endcap_cpu_mean_s"].get<double>() / c["sim_s"].get<double>());
   std::printf("            load average %.2f -> %.2f over the run; steal %.2f s (hypervisor)\n",
               c["load_average_start"].get<double>(), c["load_average_end"].get<double>(), c["steal_s"].get<double>());
 }
@@ -314,25 +317,31 @@ void run_bench_hil(const BenchHilArgs& args) {
   print_link(l["link"]);
   const auto& r = j["realtime"];
   const auto& rc = r["run"];
-  std::printf("  realtime  %lld steps, %lld late (%.4f%%; target < %.1f%%, ratio %.2f), worst %.3f ms late, end-cap overruns %llu\n",
-              r["steps"].get<long long>(), r["late_steps"].get<long long>(), 100.0 * r["late_rate"].get<double>(),
-              100.0 * kTargetLateRate, r["ratio_to_target"].get<double>(), 1e3 * r["max_lateness_s"].get<double>(),
-              r["endcap_overruns"].get<unsigned long long>());
-  std::printf("            %lld episode(s), stalled %.3f s in all; lateness p50 %.0f us, p99 %.0f us, p99.9 %.0f us (10 us buckets)\n",
-              r["late_episodes"].get<long long>(), r["stalled_s"].get<double>(), 1e6 * r["lateness_p50_s"].get<double>(),
-              1e6 * r["lateness_p99_s"].get<double>(), 1e6 * r["lateness_p999_s"].get<double>());
+  std::printf(
+      "  realtime  %lld steps, %lld late (%.4f%%; target < %.1f%%, ratio %.2f), worst %.3f ms late, end-cap overruns "
+      "%llu\n",
+      r["steps"].get<long long>(), r["late_steps"].get<long long>(), 100.0 * r["late_rate"].get<double>(),
+      100.0 * kTargetLateRate, r["ratio_to_target"].get<double>(), 1e3 * r["max_lateness_s"].get<double>(),
+      r["endcap_overruns"].get<unsigned long long>());
+  std::printf(
+      "            %lld episode(s), stalled %.3f s in all; lateness p50 %.0f us, p99 %.0f us, p99.9 %.0f us (10 us "
+      "buckets)\n",
+      r["late_episodes"].get<long long>(), r["stalled_s"].get<double>(), 1e6 * r["lateness_p50_s"].get<double>(),
+      1e6 * r["lateness_p99_s"].get<double>(), 1e6 * r["lateness_p999_s"].get<double>());
   std::printf("            late: %s\n", r["late_definition"].get<std::string>().c_str());
   std::printf("            end cap CPU %.2f%% of a core (mean), %.2f%% (max); emulator %.2f%% of a core\n",
-              100.0 * rc["endcap_core_fraction_mean"].get<double>(), 100.0 * rc["endcap_core_fraction_max"].get<double>(),
+              100.0 * rc["endcap_core_fraction_mean"].get<double>(),
+              100.0 * rc["endcap_core_fraction_max"].get<double>(),
               100.0 * rc["emulator_process_cpu_s"].get<double>() / rc["wall_s"].get<double>());
   print_link(r["link"]);
   print_cpu(rc);
   if (const auto& p = j["platform"]; !p.is_null()) {
-    std::printf("  platform  a bare 1 kHz pacing thread (%s), %lld steps before the runs: %lld late (%.4f%%) in %lld "
-                "episode(s), worst %.3f ms\n",
-                p["sched_fifo"].get<bool>() ? "SCHED_FIFO" : "normal priority", p["steps"].get<long long>(),
-                p["late_steps"].get<long long>(), 100.0 * p["late_rate"].get<double>(),
-                p["late_episodes"].get<long long>(), 1e3 * p["max_lateness_s"].get<double>());
+    std::printf(
+        "  platform  a bare 1 kHz pacing thread (%s), %lld steps before the runs: %lld late (%.4f%%) in %lld "
+        "episode(s), worst %.3f ms\n",
+        p["sched_fifo"].get<bool>() ? "SCHED_FIFO" : "normal priority", p["steps"].get<long long>(),
+        p["late_steps"].get<long long>(), 100.0 * p["late_rate"].get<double>(), p["late_episodes"].get<long long>(),
+        1e3 * p["max_lateness_s"].get<double>());
   }
 }
 
@@ -340,16 +349,24 @@ void run_bench_hil(const BenchHilArgs& args) {
 
 void add_bench_hil_command(CLI::App& bench) {
   auto args = std::make_shared<BenchHilArgs>();
-  CLI::App* cmd = bench.add_subcommand("hil", "HIL with 12 end caps: lockstep speed-up, real-time late steps, CPU per end cap");
-  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")->check(CLI::ExistingFile);
-  cmd->add_option("--lockstep-duration", args->lockstep_s, "Lockstep physics time, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
-  cmd->add_option("--realtime-duration", args->realtime_s, "Real-time run, s")->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+  CLI::App* cmd =
+      bench.add_subcommand("hil", "HIL with 12 end caps: lockstep speed-up, real-time late steps, CPU per end cap");
+  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--lockstep-duration", args->lockstep_s, "Lockstep physics time, s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--realtime-duration", args->realtime_s, "Real-time run, s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--probe-duration", args->probe_s,
                   "Before the runs, a bare pacing thread for this long: the platform's late rate (0: skip)")
-      ->capture_default_str()->check(CLI::Range(0.0, 3600.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3600.0));
   cmd->add_option("--endcap", args->endcap, "The endcap program");
   cmd->add_option("--provision", args->provision, "dds or local (see `tensegrity hil --help`)")
-      ->capture_default_str()->check(CLI::IsMember({"dds", "local"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"dds", "local"}));
   cmd->add_flag("--json", args->json, "Print one JSON object");
 #ifdef TENSEGRITY_CLI_DDS
   add_security_options(*cmd, args->keystore, args->insecure);

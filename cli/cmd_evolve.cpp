@@ -131,8 +131,7 @@ sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig
 
 // The gait's strut spin and ground contacts, from one more episode of the policy
 // through the control core: every learned gait reports whether it rolls or skates.
-sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveConfig& config,
-                             sim::Policy& policy) {
+sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveConfig& config, sim::Policy& policy) {
   sim::CoreController controller(robot, policy);
   sim::EpisodeOptions episode;
   episode.duration_s = config.duration_s;
@@ -186,8 +185,8 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
   const std::int64_t episodes_here = evo.episodes() - o.result.resumed_episodes;
   const double rate = o.wall_s > 0.0 ? static_cast<double>(episodes_here) / o.wall_s : 0.0;
   const double infeasible_last = evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate();
-  std::printf("evolve %s: %d generations, %lld episodes%s\n", sim::evolve::to_string(config.method),
-              evo.generation(), static_cast<long long>(evo.episodes()), o.result.resumed ? " (resumed)" : "");
+  std::printf("evolve %s: %d generations, %lld episodes%s\n", sim::evolve::to_string(config.method), evo.generation(),
+              static_cast<long long>(evo.episodes()), o.result.resumed ? " (resumed)" : "");
   std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
               o.final_result.score_m, o.final_result.feasible ? "" : " INFEASIBLE");
   std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
@@ -270,13 +269,20 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
 
 void add_evolve_command(CLI::App& app) {
   auto args = std::make_shared<EvolveArgs>();
-  CLI::App* cmd = app.add_subcommand("evolve", "Coevolve a rolling policy (cooperative coevolution, paper Algorithm 1)");
-  cmd->add_option("--period", args->period_s, "Signal period, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
-  cmd->add_option("--complexity", args->complexity, "Values per cable signal")->capture_default_str()->check(CLI::Range(1, 16));
+  CLI::App* cmd =
+      app.add_subcommand("evolve", "Coevolve a rolling policy (cooperative coevolution, paper Algorithm 1)");
+  cmd->add_option("--period", args->period_s, "Signal period, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 3600.0));
+  cmd->add_option("--complexity", args->complexity, "Values per cable signal")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
   cmd->add_option("--method", args->method, "Fitness: historical|leniency|average")
       ->capture_default_str()
       ->check(CLI::IsMember({"historical", "leniency", "average"}));
-  cmd->add_option("--episodes", args->episodes, "Episode budget")->capture_default_str()->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  cmd->add_option("--episodes", args->episodes, "Episode budget")
+      ->capture_default_str()
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
   cmd->add_option("--seed", args->seed, "Random seed (the run depends on it alone)")->capture_default_str();
   cmd->add_option("--threads", args->threads,
                   "Worker threads (default: all cores; with --mpi per rank, the CPUs it may use); results do not "
@@ -287,9 +293,15 @@ void add_evolve_command(CLI::App& app) {
                 "Continue the run checkpointed in --checkpoint (a larger --episodes extends a finished run)");
   // Not checked by the parser: with --mpi only rank 0 reads it, the other machines need no copy.
   cmd->add_option("--robot", args->robot, "Robot description");
-  cmd->add_option("--population", args->population, "Members per cable population")->capture_default_str()->check(CLI::Range(2, 100000));
-  cmd->add_option("--teams", args->teams, "Random teams per generation")->capture_default_str()->check(CLI::Range(1, 1000000));
-  cmd->add_option("--replace", args->replace, "Worst members replaced per generation")->capture_default_str()->check(CLI::Range(1, 50000));
+  cmd->add_option("--population", args->population, "Members per cable population")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 100000));
+  cmd->add_option("--teams", args->teams, "Random teams per generation")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--replace", args->replace, "Worst members replaced per generation")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 50000));
   cmd->add_option("--mutation", args->mutation,
                   "Mutation operator: gaussian (every value of a copy) or author (NTRT's: half the copies, half "
                   "their values)")
@@ -313,7 +325,9 @@ void add_evolve_command(CLI::App& app) {
   sigma_final->needs(anneal);
   anneal->needs(sigma_final);
   anneal_start->needs(anneal);
-  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")->capture_default_str()->check(CLI::Range(0.01, 3600.0));
+  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");

@@ -89,7 +89,8 @@ hil::HilOptions make_options(const HilArgs& a) {
   if (a.secure && a.insecure) throw CommandError(2, "hil: --secure and --insecure exclude each other");
   if (!a.insecure) o.dds_keystore = a.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(a.keystore);
 #endif
-  const sim::Robot robot = sim::load_robot(a.robot.empty() ? sim::robot_path_for_policy(o.policy) : std::filesystem::path(a.robot));
+  const sim::Robot robot =
+      sim::load_robot(a.robot.empty() ? sim::robot_path_for_policy(o.policy) : std::filesystem::path(a.robot));
   try {
     if (!a.scenario.empty()) o.scenario = hil::load_scenario(a.scenario, robot.endcap_count());
     for (const auto& f : a.faults) o.scenario.events.push_back(hil::parse_fault_option(f, robot.endcap_count()));
@@ -112,7 +113,8 @@ hil::HilOptions make_options(const HilArgs& a) {
 // run taking it in between fails this one with a clear "domain in use".
 std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& o, const sim::Robot& robot) {
   if (!args.view) return nullptr;
-  if (o.provision != hil::Provision::dds) throw CommandError(2, "hil: --view needs --provision dds (the end caps' DDS link)");
+  if (o.provision != hil::Provision::dds)
+    throw CommandError(2, "hil: --view needs --provision dds (the end caps' DDS link)");
   if (o.dds_domain < 0) o.dds_domain = hil::DomainLease(-1).domain();
   std::unique_ptr<view::LiveView> v;
   try {
@@ -143,9 +145,9 @@ void run_hil_command(const HilArgs& args) {
   hil::HilOptions options = make_options(args);
   options.stop = stop.token();
   // Before the run raises this thread's priority: the view's threads stay ordinary.
-  [[maybe_unused]] const auto page = open_view(args, options, sim::load_robot(options.robot.empty()
-                                                                 ? sim::robot_path_for_policy(options.policy)
-                                                                 : options.robot));
+  [[maybe_unused]] const auto page =
+      open_view(args, options,
+                sim::load_robot(options.robot.empty() ? sim::robot_path_for_policy(options.policy) : options.robot));
   const hil::HilResult r = hil::run_hil(options);
   if (args.json) {
     std::printf("%s\n", hil::to_json(r).dump(2).c_str());
@@ -160,17 +162,25 @@ void run_hil_command(const HilArgs& args) {
 void add_hil_command(CLI::App& app) {
   auto args = std::make_shared<HilArgs>();
   CLI::App* cmd = app.add_subcommand("hil", "Run the HIL emulator with 12 end-cap firmware processes");
-  cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names)")->check(CLI::ExistingFile);
-  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")->check(CLI::ExistingFile);
-  cmd->add_option("--duration", args->duration_s, "Physics time, seconds")->capture_default_str()->check(CLI::Range(0.001, 86400.0));
+  cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--policy", args->policy, std::string("Policy file (default: ") + kShippedPolicy + ")")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--duration", args->duration_s, "Physics time, seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 86400.0));
   cmd->add_option("--mode", args->mode, "lockstep (the emulator owns time) or realtime (1 kHz wall clock)")
-      ->capture_default_str()->check(CLI::IsMember({"lockstep", "realtime"}));
-  cmd->add_option("--scenario", args->scenario, "Fault scenario (tensegrity-hil-scenario/1 JSON)")->check(CLI::ExistingFile);
+      ->capture_default_str()
+      ->check(CLI::IsMember({"lockstep", "realtime"}));
+  cmd->add_option("--scenario", args->scenario, "Fault scenario (tensegrity-hil-scenario/1 JSON)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--fault", args->faults, "One fault, ENDCAP:FAULT@TIME_S (repeatable), e.g. 3:drive_fault@2.0");
   cmd->add_option("--record", args->record, "Per-tick CSV: time, centre, rest lengths, tensions");
-  cmd->add_option("--endcap", args->endcap, "The endcap program (default: the one built with this tree, or $TENSEGRITY_ENDCAP)");
+  cmd->add_option("--endcap", args->endcap,
+                  "The endcap program (default: the one built with this tree, or $TENSEGRITY_ENDCAP)");
   cmd->add_option("--barrier-timeout", args->barrier_timeout_s, "Lockstep: seconds to wait for an end cap's targets")
-      ->capture_default_str()->check(CLI::Range(0.01, 600.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 600.0));
   cmd->add_option("--speed", args->speed,
                   "Lockstep: physics at most this many times real time, 0 for as fast as the end caps answer "
                   "(default: 0; 1 with --view, so that the page shows the run as it would happen)")
@@ -178,9 +188,11 @@ void add_hil_command(CLI::App& app) {
   cmd->add_option("--provision", args->provision,
                   "dds: upload and start over DDS as on the robot (`tensegrity upload`/`start`); "
                   "local: each end cap gets --policy FILE --start-on-boot, no DDS")
-      ->capture_default_str()->check(CLI::IsMember({"dds", "local"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"dds", "local"}));
   cmd->add_option("--host-loss", args->host_loss, "dds: what the end caps do when the host's link is lost")
-      ->capture_default_str()->check(CLI::IsMember({"continue", "stop"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"continue", "stop"}));
   cmd->add_option("--domain", args->domain, "dds: DDS domain of this run (default: a free one of 215..232)")
       ->check(CLI::Range(0, 232));
 #ifdef TENSEGRITY_CLI_DDS
@@ -197,14 +209,17 @@ void add_hil_command(CLI::App& app) {
                   "cap goes to its safe state, so its other cable holds. spool: only the spool runs free (slack); the "
                   "end cap does not notice and keeps playing its other cable. seize: only the spool seizes (the cable "
                   "keeps its start length); the end cap plays on")
-      ->capture_default_str()->check(CLI::IsMember({"drive", "spool", "seize"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"drive", "spool", "seize"}));
   cmd->add_flag("--keep", args->keep, "Keep the run directory (configs, stores, logs)");
   cmd->add_flag("--json", args->json, "Print one JSON object");
 #ifdef TENSEGRITY_CLI_VIEW
   cmd->add_flag("--view", args->view, "Serve the live page of this run (tensegrity view --live on its domain)");
   cmd->add_option("--view-wait", args->view_wait_s, "--view: seconds to wait for a page before starting (0: none)")
-      ->capture_default_str()->check(CLI::Range(0.0, 3600.0));
-  cmd->add_option("--view-port", args->view_server.port, "--view: HTTP port of the page")->capture_default_str()
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3600.0));
+  cmd->add_option("--view-port", args->view_server.port, "--view: HTTP port of the page")
+      ->capture_default_str()
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--view-bind", args->view_server.bind, "--view: address to listen on")->capture_default_str();
 #endif

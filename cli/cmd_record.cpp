@@ -32,11 +32,12 @@ void add_record_command(CLI::App& app) {
   cmd->callback([args] {
     std::FILE* f = std::fopen(args->out.c_str(), "w");
     if (f == nullptr) throw CommandError(1, "cannot write " + args->out);
-    std::fputs("receive_host_ns,endcap,seq,host_time_ns,loop_time_ns,cycle,mode,fault,subinterval,motor_count,"
-               "commanded_m_0,commanded_m_1,commanded_m_2,commanded_m_3,measured_m_0,measured_m_1,measured_m_2,"
-               "measured_m_3,tension_n_0,tension_n_1,tension_n_2,tension_n_3,loop_overruns,policy_id,"
-               "policy_version\n",
-               f);
+    std::fputs(
+        "receive_host_ns,endcap,seq,host_time_ns,loop_time_ns,cycle,mode,fault,subinterval,motor_count,"
+        "commanded_m_0,commanded_m_1,commanded_m_2,commanded_m_3,measured_m_0,measured_m_1,measured_m_2,"
+        "measured_m_3,tension_n_0,tension_n_1,tension_n_2,tension_n_3,loop_overruns,policy_id,"
+        "policy_version\n",
+        f);
     std::mutex mutex;
     std::deque<std::pair<ground::msg::Telemetry_, std::int64_t>> queue;
     // Recording does not command anything: stay silent, do not pose as the host.
@@ -59,14 +60,15 @@ void add_record_command(CLI::App& app) {
         const auto& c = t.commanded_rest_length_m();
         const auto& m = t.measured_rest_length_m();
         const auto& n = t.tension_n();
-        std::fprintf(f, "%lld,%d,%u,%lld,%lld,%llu,%u,%u,%u,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.3f,%.3f,%.3f,%.3f,"
-                        "%llu,%s,%u\n",
-                     static_cast<long long>(at), int{t.endcap_id()}, t.seq(), static_cast<long long>(t.host_time_ns()),
-                     static_cast<long long>(t.loop_time_ns()), static_cast<unsigned long long>(t.cycle()),
-                     unsigned{t.mode()}, unsigned{t.fault()}, t.subinterval(), t.motor_count(), c[0], c[1], c[2], c[3],
-                     m[0], m[1], m[2], m[3], n[0], n[1], n[2], n[3],
-                     static_cast<unsigned long long>(t.loop_overruns()), t.active_policy_id().c_str(),
-                     t.active_policy_version());
+        std::fprintf(
+            f,
+            "%lld,%d,%u,%lld,%lld,%llu,%u,%u,%u,%u,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.3f,%.3f,%.3f,%.3f,"
+            "%llu,%s,%u\n",
+            static_cast<long long>(at), int{t.endcap_id()}, t.seq(), static_cast<long long>(t.host_time_ns()),
+            static_cast<long long>(t.loop_time_ns()), static_cast<unsigned long long>(t.cycle()), unsigned{t.mode()},
+            unsigned{t.fault()}, t.subinterval(), t.motor_count(), c[0], c[1], c[2], c[3], m[0], m[1], m[2], m[3], n[0],
+            n[1], n[2], n[3], static_cast<unsigned long long>(t.loop_overruns()), t.active_policy_id().c_str(),
+            t.active_policy_version());
         ++rows;
       }
     }

@@ -21,11 +21,13 @@ void add_security_command(CLI::App& app) {
   auto init = std::make_shared<InitArgs>();
   CLI::App* cmd = security->add_subcommand(
       "init", "Create a keystore: project CA, ground / endcap_00..11 / listener enclaves, signed documents");
-  cmd->add_option("dir", init->dir, "Keystore folder (default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore)");
+  cmd->add_option("dir", init->dir,
+                  "Keystore folder (default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore)");
   cmd->add_option("--days", init->options.valid_days, "Validity of certificates and permissions, days")
       ->check(CLI::Range(1, 36500))
       ->capture_default_str();
-  cmd->add_flag("--force", init->options.replace, "Replace an existing keystore (a new CA: every end cap needs its enclave again)");
+  cmd->add_flag("--force", init->options.replace,
+                "Replace an existing keystore (a new CA: every end cap needs its enclave again)");
   cmd->callback([init] {
     const std::filesystem::path dir = init->dir.empty() ? msgs::default_keystore() : std::filesystem::path(init->dir);
     try {
@@ -40,7 +42,8 @@ void add_security_command(CLI::App& app) {
   });
 
   auto check_dir = std::make_shared<std::string>();
-  CLI::App* check = security->add_subcommand("check", "Exit 0 when a keystore has every enclave's files and this version's permissions");
+  CLI::App* check = security->add_subcommand(
+      "check", "Exit 0 when a keystore has every enclave's files and this version's permissions");
   check->add_option("dir", *check_dir, "Keystore folder (default as for init)");
   check->callback([check_dir] {
     const std::filesystem::path dir = check_dir->empty() ? msgs::default_keystore() : std::filesystem::path(*check_dir);

@@ -58,9 +58,8 @@ void run_sim(const SimArgs& args) {
     j["dt_s"] = options.dt_s > 0 ? options.dt_s : robot.time_step_s;
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("robot %s (%s), %s, %.1f s at dt %.4g s, %s start\n", robot.name.c_str(),
-                robot.hash.c_str(), controller_name.c_str(), args.duration_s,
-                options.dt_s > 0 ? options.dt_s : robot.time_step_s,
+    std::printf("robot %s (%s), %s, %.1f s at dt %.4g s, %s start\n", robot.name.c_str(), robot.hash.c_str(),
+                controller_name.c_str(), args.duration_s, options.dt_s > 0 ? options.dt_s : robot.time_step_s,
                 options.start == sim::StartKind::drop ? "drop" : "settled");
     print_episode_summary(result);
   }
@@ -71,18 +70,18 @@ void run_sim(const SimArgs& args) {
 void add_sim_command(CLI::App& app) {
   auto args = std::make_shared<SimArgs>();
   CLI::App* cmd = app.add_subcommand("sim", "Run one episode of the robot model and summarise it");
-  cmd->add_option("--robot", args->robot, "Robot description (default: the one the policy names, else robots/superball.json)")
+  cmd->add_option("--robot", args->robot,
+                  "Robot description (default: the one the policy names, else robots/superball.json)")
       ->check(CLI::ExistingFile);
-  auto* policy = cmd->add_option("--policy", args->policy, "Policy file to play (tensegrity-policy/1)")
-                     ->check(CLI::ExistingFile);
+  auto* policy =
+      cmd->add_option("--policy", args->policy, "Policy file to play (tensegrity-policy/1)")->check(CLI::ExistingFile);
   cmd->add_flag("--benchmark-policy", args->benchmark_policy,
                 "Play the fixed benchmark policy (the default without --policy)")
       ->excludes(policy);
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
-  cmd->add_option("--dt", args->dt_s, "Time step, seconds (default: the robot's)")
-      ->check(CLI::Range(1e-5, 0.01));
+  cmd->add_option("--dt", args->dt_s, "Time step, seconds (default: the robot's)")->check(CLI::Range(1e-5, 0.01));
   auto* start = cmd->add_option("--start", args->start,
                                 "Start: settled (at rest on the ground; default with --policy) or drop "
                                 "(the benchmark's start; default without)")

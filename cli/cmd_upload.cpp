@@ -32,15 +32,16 @@ void add_upload_command(CLI::App& app) {
   cmd->add_flag("--force", args->force, "Accept a version not newer than the active one");
   add_ground_options(*cmd, args->ground, 10.0);
   cmd->callback([args] {
-    const sim::Robot robot = sim::load_robot(args->robot.empty() ? sim::robot_path_for_policy(args->policy) : std::filesystem::path(args->robot));
+    const sim::Robot robot = sim::load_robot(args->robot.empty() ? sim::robot_path_for_policy(args->policy)
+                                                                 : std::filesystem::path(args->robot));
     const sim::Policy policy = sim::load_policy(args->policy, robot);
     fw::comms::PolicyIdentity identity;
     identity.policy_id = args->id.empty() ? std::filesystem::path(args->policy).stem().string() : args->id;
     if (identity.policy_id.empty() || identity.policy_id.size() > 64) {
       throw CommandError(2, "policy id '" + identity.policy_id + "' must be 1..64 characters (--id)");
     }
-    identity.policy_version = args->version > 0 ? static_cast<std::uint32_t>(args->version)
-                                                : static_cast<std::uint32_t>(std::time(nullptr));
+    identity.policy_version =
+        args->version > 0 ? static_cast<std::uint32_t>(args->version) : static_cast<std::uint32_t>(std::time(nullptr));
     identity.robot = robot.name;
     identity.force = args->force;
     std::vector<ground::msg::PolicyTable_> tables =

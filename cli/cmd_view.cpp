@@ -79,7 +79,8 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("run", args->run_csv, "Telemetry CSV to replay (tensegrity sim --telemetry, tensegrity hil --record)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--live", args->live, "The end caps' DDS telemetry and heartbeats, live (read-only)");
-  cmd->add_option("--evolve", args->evolve_dir, "An evolution's checkpoint directory (tensegrity evolve --checkpoint DIR)")
+  cmd->add_option("--evolve", args->evolve_dir,
+                  "An evolution's checkpoint directory (tensegrity evolve --checkpoint DIR)")
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--robot", args->robot,
                   "Robot description (tension limits, cables); default: robots/superball.json, for --evolve the run's")

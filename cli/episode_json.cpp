@@ -45,8 +45,8 @@ void print_episode_summary(const sim::EpisodeResult& r) {
   std::printf("  motors         %.1f J, %.2f W per cable on average\n", r.motor_energy_j, r.mean_motor_power_w);
   std::printf("  strut spin     %.2f rad/s RMS, %.2f max about their axes; %d end caps touched the ground\n",
               r.axial_spin_rms_rad_per_s, r.axial_spin_max_rad_per_s, r.endcaps_touched_ground);
-  std::printf("  time           %.2f s simulated in %.3f s wall (%.0fx real time)\n", r.sim_time_s,
-              r.wall_time_s, r.real_time_factor());
+  std::printf("  time           %.2f s simulated in %.3f s wall (%.0fx real time)\n", r.sim_time_s, r.wall_time_s,
+              r.real_time_factor());
 }
 
 std::unique_ptr<sim::Controller> make_policy_controller(const sim::Robot& robot, const std::string& path) {

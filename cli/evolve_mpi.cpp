@@ -28,12 +28,14 @@ void check_evolve_launch(bool mpi) {
     return;
   }
   if (!sim::evolve::mpi_built()) {
-    throw CommandError(2, "--mpi: this tensegrity was built without MPI (install libopenmpi-dev and configure "
-                          "with -DTENSEGRITY_WITH_MPI=ON)");
+    throw CommandError(2,
+                       "--mpi: this tensegrity was built without MPI (install libopenmpi-dev and configure "
+                       "with -DTENSEGRITY_WITH_MPI=ON)");
   }
   if (!launched) {
-    throw CommandError(2, "--mpi: not started by mpirun; run e.g. `mpirun -np 4 tensegrity evolve ... --mpi` "
-                          "(docs/evolve.md)");
+    throw CommandError(2,
+                       "--mpi: not started by mpirun; run e.g. `mpirun -np 4 tensegrity evolve ... --mpi` "
+                       "(docs/evolve.md)");
   }
 }
 

@@ -37,8 +37,10 @@ std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore,
   const char* env = std::getenv("TENSEGRITY_KEYSTORE");
   const bool named = !keystore.empty() || (env != nullptr && *env != '\0');
   if (!named && !std::filesystem::exists(msgs::default_keystore())) {
-    std::fprintf(stderr, "tensegrity: DDS link unsecured (no keystore: --keystore, TENSEGRITY_KEYSTORE or %s; "
-                 "docs/security.md)\n", msgs::default_keystore().c_str());
+    std::fprintf(stderr,
+                 "tensegrity: DDS link unsecured (no keystore: --keystore, TENSEGRITY_KEYSTORE or %s; "
+                 "docs/security.md)\n",
+                 msgs::default_keystore().c_str());
     return {};
   }
   const std::filesystem::path store = keystore.empty() ? msgs::default_keystore() : std::filesystem::path(keystore);

@@ -1,7 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
 // `tensegrity`: the host program (simulate, benchmark, evolve, upload, HIL, ...).
-#include <spdlog/spdlog.h>
-
 #include <cstdio>
 #include <exception>
 

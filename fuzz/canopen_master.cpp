@@ -39,7 +39,8 @@ canopen::CanopenMasterConfig config_from(FuzzedDataProvider& in) {
 fw::CanFrame frame_from(FuzzedDataProvider& in) {
   fw::CanFrame frame;
   // Mostly ids the master listens to (0x000-0x7FF), now and then anything at all.
-  frame.id = in.ConsumeBool() ? in.ConsumeIntegralInRange<std::uint32_t>(0, 0x7FF) : in.ConsumeIntegral<std::uint32_t>();
+  frame.id =
+      in.ConsumeBool() ? in.ConsumeIntegralInRange<std::uint32_t>(0, 0x7FF) : in.ConsumeIntegral<std::uint32_t>();
   frame.extended = in.ConsumeBool() && in.ConsumeBool();
   frame.rtr = in.ConsumeBool() && in.ConsumeBool();
   frame.dlc = in.ConsumeIntegralInRange<std::uint8_t>(0, 15);  // > 8 too: a broken driver
@@ -59,7 +60,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     now_ns += in.ConsumeIntegralInRange<std::int64_t>(0, 200'000'000);
     switch (in.ConsumeIntegralInRange<int>(0, 7)) {
       case 0: master.poll(now_ns); break;
-      case 1: (void)master.write_target(in.ConsumeIntegralInRange<std::size_t>(0, 3), in.ConsumeFloatingPoint<double>()); break;
+      case 1:
+        (void)master.write_target(in.ConsumeIntegralInRange<std::size_t>(0, 3), in.ConsumeFloatingPoint<double>());
+        break;
       case 2: master.request_fault_reset(); break;
       default: master.on_frame(frame_from(in), now_ns); break;
     }

@@ -19,7 +19,7 @@ const char* to_string(CommandKind kind);
 
 struct CommandOptions {
   std::uint16_t endcap_mask = kAllEndcaps;
-  double timeout_s = 5.0;        // the deadline: end caps silent until then are reported missing
+  double timeout_s = 5.0;         // the deadline: end caps silent until then are reported missing
   double retry_interval_s = 0.5;  // re-sent (same seq) to every end cap that has not acked
 };
 // An emergency stop is re-sent more often: each retry is one more chance through a

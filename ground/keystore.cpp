@@ -104,7 +104,8 @@ void make_enclave(const fs::path& root, const std::string& enclave, int serial, 
   // find its own permissions "not yet valid".
   const std::time_t now = std::time(nullptr);
   write_text(dir / "permissions.xml",
-             msgs::permissions_xml(enclave, utc(now - 86400), utc(now + static_cast<std::time_t>(options.valid_days) * 86400)));
+             msgs::permissions_xml(enclave, utc(now - 86400),
+                                   utc(now + static_cast<std::time_t>(options.valid_days) * 86400)));
   sign(dir / "permissions.xml", dir / "permissions.p7s", ca_cert, ca_key, log);
 }
 
@@ -117,9 +118,25 @@ void build(const fs::path& root, const KeystoreOptions& options) {
   const fs::path ca_cert = root / "public" / "ca.cert.pem", ca_key = root / "private" / "ca.key.pem";
   // digitalSignature beside the CA usages: the CA itself signs the governance and
   // permissions (S/MIME), which a verifier otherwise refuses as the wrong purpose.
-  openssl({"req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes", "-keyout",
-           ca_key.string(), "-out", ca_cert.string(), "-days", std::to_string(options.valid_days), "-sha256", "-subj",
-           "/CN=tensegrity keystore CA", "-addext", "basicConstraints=critical,CA:TRUE", "-addext",
+  openssl({"req",
+           "-x509",
+           "-newkey",
+           "ec",
+           "-pkeyopt",
+           "ec_paramgen_curve:prime256v1",
+           "-nodes",
+           "-keyout",
+           ca_key.string(),
+           "-out",
+           ca_cert.string(),
+           "-days",
+           std::to_string(options.valid_days),
+           "-sha256",
+           "-subj",
+           "/CN=tensegrity keystore CA",
+           "-addext",
+           "basicConstraints=critical,CA:TRUE",
+           "-addext",
            "keyUsage=critical,keyCertSign,cRLSign,digitalSignature"},
           log);
   for (const char* name : {"identity_ca", "permissions_ca"}) {
@@ -157,8 +174,8 @@ std::string keystore_problem(const fs::path& dir) {
     if (signed_text.find(msgs::permission_rules(enclave)) == std::string::npos) {
       return (enclave_dir / "permissions.p7s").string() +
              ": grants other rules than this version does (a keystore made by an older version: end caps now "
-             "publish in their own partitions); recreate it with `tensegrity security init " + dir.string() +
-             " --force` and copy each end cap its enclave again";
+             "publish in their own partitions); recreate it with `tensegrity security init " +
+             dir.string() + " --force` and copy each end cap its enclave again";
     }
   }
   return {};
@@ -167,10 +184,12 @@ std::string keystore_problem(const fs::path& dir) {
 bool keystore_complete(const fs::path& dir) { return keystore_problem(dir).empty(); }
 
 void create_keystore(const fs::path& dir_in, const KeystoreOptions& options) {
-  if (options.valid_days < 1) throw KeystoreError("valid_days = " + std::to_string(options.valid_days) + ": expected >= 1");
+  if (options.valid_days < 1)
+    throw KeystoreError("valid_days = " + std::to_string(options.valid_days) + ": expected >= 1");
   const fs::path dir = fs::absolute(dir_in).lexically_normal();
   if (fs::exists(dir) && !options.replace) {
-    throw KeystoreError(dir.string() + " exists (pass --force to replace it: every end cap then needs its enclave again)");
+    throw KeystoreError(dir.string() +
+                        " exists (pass --force to replace it: every end cap then needs its enclave again)");
   }
   fs::create_directories(dir.parent_path());
   const fs::path staging = staging_dir(dir);

@@ -47,7 +47,7 @@ struct StationOptions {
 };
 
 struct EndcapStatus {
-  bool seen = false;               // a heartbeat arrived
+  bool seen = false;                   // a heartbeat arrived
   std::int64_t heartbeat_host_ns = 0;  // host clock at its arrival
   msg::Heartbeat_ heartbeat;
   bool have_telemetry = false;

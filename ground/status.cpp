@@ -63,21 +63,19 @@ std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& st
       continue;
     }
     const auto& hb = s.heartbeat;
-    const std::string policy = hb.active_policy_id().size() == 0
-                                   ? "-"
-                                   : hb.active_policy_id().to_string() + " v" +
-                                         std::to_string(hb.active_policy_version());
+    const std::string policy = hb.active_policy_id().size() == 0 ? "-"
+                                                                 : hb.active_policy_id().to_string() + " v" +
+                                                                       std::to_string(hb.active_policy_version());
     char tensions[64] = "-";
     if (s.have_telemetry) {
       const auto& t = s.telemetry.tension_n();
       std::snprintf(tensions, sizeof tensions, "%.0f/%.0f", t[0], t[1]);
     }
-    std::snprintf(line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s\n", e,
-                  static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9, policy.c_str(), mode_name(hb.mode()),
-                  fault_name(hb.fault()), tensions,
-                  hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
-                  hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0,
-                  hb.host_lost() ? "LOST" : "ok");
+    std::snprintf(
+        line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s\n", e,
+        static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9, policy.c_str(), mode_name(hb.mode()),
+        fault_name(hb.fault()), tensions, hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
+        hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0, hb.host_lost() ? "LOST" : "ok");
     out += line;
   }
   return out;

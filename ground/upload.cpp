@@ -85,8 +85,8 @@ std::string format_upload_report(const UploadReport& report) {
   char line[512];
   for (const auto& r : report.results) {
     const char* result = !r.acked ? "MISSING" : r.accepted ? "accepted" : "REJECTED";
-    std::string active = r.active_policy_id.empty() ? "-" : r.active_policy_id + " v" +
-                                                                std::to_string(r.active_policy_version);
+    std::string active =
+        r.active_policy_id.empty() ? "-" : r.active_policy_id + " v" + std::to_string(r.active_policy_version);
     std::snprintf(line, sizeof line, "%6d  %-8s  %5d  %10.1f  %-25s  %s\n", r.endcap, result, r.attempts,
                   r.acked ? r.latency_s * 1e3 : NAN, active.c_str(),
                   r.acked ? (std::string(fw::comms::to_string(r.reason)) + ": " + r.text).c_str() : r.text.c_str());

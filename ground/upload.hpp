@@ -17,8 +17,7 @@ namespace tensegrity::ground {
 // One message per end cap of `robot`, each addressed to and checksummed for its
 // end cap; upload sequences are `first_sequence + endcap`.
 std::vector<msg::PolicyTable_> policy_messages(const sim::Policy& policy, const sim::Robot& robot,
-                                               const fw::comms::PolicyIdentity& identity,
-                                               std::uint32_t first_sequence);
+                                               const fw::comms::PolicyIdentity& identity, std::uint32_t first_sequence);
 
 // A fresh random base for upload and command sequence numbers: acks from an
 // earlier run, kept in an end cap's transient-local history, must not match.

@@ -19,7 +19,7 @@ namespace tensegrity::hil {
 
 class AnswerNap {
  public:
-  static constexpr double kSmoothing = 0.05;    // weight of a new tick
+  static constexpr double kSmoothing = 0.05;  // weight of a new tick
   static constexpr std::int64_t kMaxNapNs = 1'000'000;
 
   // `fraction` of the smoothed latency; 0 turns the nap off.

@@ -131,7 +131,8 @@ void DdsProvisioner::clear_faults_or_fail(std::uint16_t mask) {
   const auto status = station_->snapshot();
   for (int e = 0; e < robot_.endcap_count(); ++e) {
     if (status[e].heartbeat.fault() != 0) {
-      why += (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
+      why +=
+          (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
     }
   }
   throw HilError("end cap(s) " + why + " still faulted after a clear-fault before the start");
@@ -146,7 +147,8 @@ std::int64_t DdsProvisioner::place_start(StartHandshake& handshake, std::string&
     const FrozenTick frozen = handshake.freeze(ground::Station::now_ns() + 10 * kNsPerS);
     how = "SYNC +" + std::to_string(config_.start_after_ticks) + " after the freeze (last tick answered in " +
           std::to_string((frozen.answered_ns - frozen.sent_ns) / 1000) + " us)";
-    return frozen.sent_ns + config_.start_after_ticks * endcap_period_ns(robot_) + (frozen.answered_ns - frozen.sent_ns) / 2;
+    return frozen.sent_ns + config_.start_after_ticks * endcap_period_ns(robot_) +
+           (frozen.answered_ns - frozen.sent_ns) / 2;
   }
   char in[48];
   std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);
@@ -210,14 +212,15 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
     worst_round_trip_ms = std::max(worst_round_trip_ms, static_cast<double>(s.heartbeat.clock_round_trip_ns()) * 1e-6);
   }
   char line[512];
-  std::snprintf(line, sizeof line,
-                "dds: %d end caps on domain %d (%s) in %.0f ms; policy %s v%u uploaded in %.1f ms (slowest ack %.1f ms); "
-                "start at host time %.6f s (%s); time sync at the start: worst round trip %.3f ms; at the end of "
-                "the hold: worst offset %.3f ms, worst round trip %.3f ms",
-                n, lease_.domain(), config_.keystore.empty() ? "UNSECURED, --insecure" : "secured, DDS Security",
-                static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(),
-                identity.policy_version, upload_s * 1e3, worst_ack_s * 1e3, static_cast<double>(start_ns) * 1e-9,
-                how.c_str(), settle_rt_ms, worst_offset_ms, worst_round_trip_ms);
+  std::snprintf(
+      line, sizeof line,
+      "dds: %d end caps on domain %d (%s) in %.0f ms; policy %s v%u uploaded in %.1f ms (slowest ack %.1f ms); "
+      "start at host time %.6f s (%s); time sync at the start: worst round trip %.3f ms; at the end of "
+      "the hold: worst offset %.3f ms, worst round trip %.3f ms",
+      n, lease_.domain(), config_.keystore.empty() ? "UNSECURED, --insecure" : "secured, DDS Security",
+      static_cast<double>(t_found - t0) * 1e-6, identity.policy_id.c_str(), identity.policy_version, upload_s * 1e3,
+      worst_ack_s * 1e3, static_cast<double>(start_ns) * 1e-9, how.c_str(), settle_rt_ms, worst_offset_ms,
+      worst_round_trip_ms);
   note(line);
   {
     std::lock_guard lock(mutex_);
@@ -268,7 +271,7 @@ double DdsProvisioner::settle_time_sync(std::uint16_t mask, std::int64_t deadlin
       if ((mask & (1U << e)) == 0) continue;
       const ground::EndcapStatus s = station_->snapshot()[e];
       worst = std::max(worst, s.seen && s.heartbeat.clock_synced() ? s.heartbeat.clock_round_trip_ns()
-                                                                     : std::numeric_limits<std::int64_t>::max());
+                                                                   : std::numeric_limits<std::int64_t>::max());
     }
     if (worst <= limit_ns || ground::Station::now_ns() >= deadline_ns) return static_cast<double>(worst) * 1e-9;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -277,7 +280,8 @@ double DdsProvisioner::settle_time_sync(std::uint16_t mask, std::int64_t deadlin
 
 void DdsProvisioner::on_restart(int endcap) {
   std::lock_guard lock(mutex_);
-  if (endcap >= 0 && endcap < static_cast<int>(restarted_at_ns_.size())) restarted_at_ns_[endcap] = ground::Station::now_ns();
+  if (endcap >= 0 && endcap < static_cast<int>(restarted_at_ns_.size()))
+    restarted_at_ns_[endcap] = ground::Station::now_ns();
 }
 
 void DdsProvisioner::begin_run() {
@@ -335,8 +339,8 @@ void DdsProvisioner::supervise() {
                          s.telemetry.fault() == 0;
       if (!ready) continue;
       // Its phase is as good as its clock: give the time sync a moment.
-      const double round_trip_s = settle_time_sync(static_cast<std::uint16_t>(1U << e),
-                                                   ground::Station::now_ns() + to_ns(config_.rejoin_sync_settle_timeout_s));
+      const double round_trip_s = settle_time_sync(
+          static_cast<std::uint16_t>(1U << e), ground::Station::now_ns() + to_ns(config_.rejoin_sync_settle_timeout_s));
       ground::CommandOptions co;
       co.endcap_mask = static_cast<std::uint16_t>(1U << e);
       co.timeout_s = config_.command_timeout_s;

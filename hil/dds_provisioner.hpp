@@ -37,7 +37,7 @@
 namespace tensegrity::hil {
 
 struct DdsProvisionerConfig {
-  int domain = -1;                  // -1: lease a free one (DomainLease)
+  int domain = -1;                     // -1: lease a free one (DomainLease)
   std::string host_loss = "continue";  // the end caps' --host-loss
   // DDS Security: the keystore the HIL's ground station and end caps take their
   // enclaves from (created if missing). Empty: unsecured (`hil --insecure`).
@@ -117,7 +117,7 @@ class DdsProvisioner final : public Provisioner {
 
   mutable std::mutex mutex_;
   std::vector<std::string> log_;
-  LinkTiming timing_;  // under mutex_
+  LinkTiming timing_;                          // under mutex_
   std::vector<std::int64_t> restarted_at_ns_;  // per end cap: host time of a restart not yet started (0: none)
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;

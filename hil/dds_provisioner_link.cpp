@@ -55,7 +55,8 @@ bool DdsProvisioner::wait_or_rejoin(std::uint16_t mask, std::int64_t deadline_ns
       last = n;
       grew_ns = after;
     } else if (after - grew_ns > kRejoinAfterNs && n > 0 && !station_options_.enclave_dir.empty()) {
-      note("dds: " + std::to_string(n) + " end caps heard, no more for 8 s: the ground station joins again "
+      note("dds: " + std::to_string(n) +
+           " end caps heard, no more for 8 s: the ground station joins again "
            "(a DDS Security handshake that never completed)");
       station_.reset();
       station_ = std::make_unique<ground::Station>(station_options_);

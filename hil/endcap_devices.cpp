@@ -16,9 +16,9 @@ EndcapDevices::EndcapDevices(int endcap, std::vector<int> cables, const fw::Spoo
   drives_.reserve(cables_.size());
   for (std::size_t m = 0; m < cables_.size(); ++m) {
     SimCia402Drive& d = drives_.emplace_back(kDriveNodeIds[m]);
-    d.ideal_position = false;       // the position is the model's rest length
-    d.tpdo_on_sync = !lockstep;     // lockstep: sensors go out before SYNC
-    d.hold_enable = true;           // the start gate: enabled in phase by the stepper
+    d.ideal_position = false;    // the position is the model's rest length
+    d.tpdo_on_sync = !lockstep;  // lockstep: sensors go out before SYNC
+    d.hold_enable = true;        // the start gate: enabled in phase by the stepper
     d.log_controlwords = false;
   }
   load_cell_.tpdo_on_sync = !lockstep;
@@ -47,7 +47,8 @@ void EndcapDevices::update_from_model(std::span<const double> rest_length_m, std
   std::array<double, 2> t{};
   for (std::size_t m = 0; m < drives_.size(); ++m) {
     const int c = cables_[m];
-    drives_[m].set_actual(spool_.counts_from_rest_length(rest_length_m[c]), spool_.counts_per_s_from_rate(rate_m_per_s[c]));
+    drives_[m].set_actual(spool_.counts_from_rest_length(rest_length_m[c]),
+                          spool_.counts_per_s_from_rate(rate_m_per_s[c]));
     if (m < 2) t[m] = tension_n[c];
   }
   load_cell_.set_tensions_n(t[0], t[1], now_ns);

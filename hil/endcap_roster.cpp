@@ -44,8 +44,8 @@ void EndcapRoster::fail_on_exit(std::int64_t now_ns) {
   if (!exit_check_.due(now_ns)) return;
   for (int e = 0; e < size(); ++e) {
     if (!processes_.exited(e)) continue;
-    throw HilError("boot: end cap " + std::to_string(e) + "'s program exited before the start gate: " +
-                   processes_.describe(e));
+    throw HilError("boot: end cap " + std::to_string(e) +
+                   "'s program exited before the start gate: " + processes_.describe(e));
   }
 }
 
@@ -68,8 +68,8 @@ void EndcapRoster::await_restarted(Clock& clock, const std::stop_token& stop, st
     for (int e = 0; e < size(); ++e) {
       if (endcaps_[e].state != EndcapState::waiting_process || !processes_.exited(e)) continue;
       throw HilError("lockstep: end cap " + std::to_string(e) +
-                     "'s restarted program exited before it listened on its bus (physics step " +
-                     std::to_string(step) + "): " + processes_.describe(e));
+                     "'s restarted program exited before it listened on its bus (physics step " + std::to_string(step) +
+                     "): " + processes_.describe(e));
     }
     if (clock.now_ns() - t0 > timeout_ns) {
       std::ostringstream why;

@@ -50,7 +50,8 @@ nlohmann::json to_json(const HilResult& r) {
           {"steps", r.stats.steps},
           {"boot_ticks", r.stats.boot_ticks},
           {"late_steps", r.stats.late_steps},
-          {"late_rate", r.stats.steps > 0 ? static_cast<double>(r.stats.late_steps) / static_cast<double>(r.stats.steps) : 0.0},
+          {"late_rate",
+           r.stats.steps > 0 ? static_cast<double>(r.stats.late_steps) / static_cast<double>(r.stats.steps) : 0.0},
           {"max_lateness_s", r.stats.max_lateness_s},
           {"max_barrier_wait_s", r.stats.max_barrier_wait_s},
           {"send_wall_s", r.stats.send_wall_s},
@@ -82,14 +83,16 @@ std::string summary_text(const HilResult& r) {
                 r.provisioner.c_str(), r.playing, r.max_phase_offset_s * 1e3);
   s << line;
   if (r.mode == StepperMode::realtime) {
-    std::snprintf(line, sizeof line, "late steps %lld of %lld (%.4f%%), worst %.3f ms late\n",
-                  static_cast<long long>(r.stats.late_steps), static_cast<long long>(r.stats.steps),
-                  r.stats.steps ? 100.0 * static_cast<double>(r.stats.late_steps) / static_cast<double>(r.stats.steps) : 0.0,
-                  r.stats.max_lateness_s * 1e3);
+    std::snprintf(
+        line, sizeof line, "late steps %lld of %lld (%.4f%%), worst %.3f ms late\n",
+        static_cast<long long>(r.stats.late_steps), static_cast<long long>(r.stats.steps),
+        r.stats.steps ? 100.0 * static_cast<double>(r.stats.late_steps) / static_cast<double>(r.stats.steps) : 0.0,
+        r.stats.max_lateness_s * 1e3);
     s << line;
   }
   for (const auto& l : r.log) s << "  " << l << "\n";
-  s << "end cap  fault                 phase_ms  host lost/back  overruns  rx_drops  frames in/out  injected drop/corrupt  EMCY  cpu_s  drives\n";
+  s << "end cap  fault                 phase_ms  host lost/back  overruns  rx_drops  frames in/out  injected "
+       "drop/corrupt  EMCY  cpu_s  drives\n";
   for (const auto& e : r.endcaps) {
     std::string drives;
     for (const auto& d : e.devices.drive_states) drives += (drives.empty() ? "" : ", ") + d;
@@ -99,15 +102,15 @@ std::string summary_text(const HilResult& r) {
     } else {
       std::snprintf(phase, sizeof phase, "%8s", "-");
     }
-    std::snprintf(line, sizeof line, "%7d  %-20s  %s  %9llu/%-4llu  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n",
-                  e.endcap, e.fault.c_str(), phase, static_cast<unsigned long long>(e.host_losses),
-                  static_cast<unsigned long long>(e.host_returns),
-                  static_cast<unsigned long long>(e.overruns), static_cast<unsigned long long>(e.rx_drops),
-                  static_cast<unsigned long long>(e.bus.rx_frames), static_cast<unsigned long long>(e.bus.tx_frames),
-                  static_cast<unsigned long long>(e.bus.injected_drops),
-                  static_cast<unsigned long long>(e.bus.injected_corrupt),
-                  static_cast<unsigned long long>(e.devices.emcy_sent), e.cpu_s, drives.c_str(),
-                  e.restarts ? (" (restarted " + std::to_string(e.restarts) + "x)").c_str() : "");
+    std::snprintf(
+        line, sizeof line,
+        "%7d  %-20s  %s  %9llu/%-4llu  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n", e.endcap,
+        e.fault.c_str(), phase, static_cast<unsigned long long>(e.host_losses),
+        static_cast<unsigned long long>(e.host_returns), static_cast<unsigned long long>(e.overruns),
+        static_cast<unsigned long long>(e.rx_drops), static_cast<unsigned long long>(e.bus.rx_frames),
+        static_cast<unsigned long long>(e.bus.tx_frames), static_cast<unsigned long long>(e.bus.injected_drops),
+        static_cast<unsigned long long>(e.bus.injected_corrupt), static_cast<unsigned long long>(e.devices.emcy_sent),
+        e.cpu_s, drives.c_str(), e.restarts ? (" (restarted " + std::to_string(e.restarts) + "x)").c_str() : "");
     s << line;
   }
   return s.str();

@@ -136,10 +136,10 @@ struct RunParts {
 };
 
 void load_inputs(const HilOptions& options, RunParts& parts) {
-  parts.robot = std::make_unique<sim::Robot>(
-      sim::load_robot(!options.robot.empty() ? options.robot
-                      : options.policy.empty() ? sim::default_robot_path()
-                                               : sim::robot_path_for_policy(options.policy)));
+  parts.robot = std::make_unique<sim::Robot>(sim::load_robot(!options.robot.empty() ? options.robot
+                                                             : options.policy.empty()
+                                                                 ? sim::default_robot_path()
+                                                                 : sim::robot_path_for_policy(options.policy)));
   if (options.policy.empty()) throw HilError("no policy file (--policy)");
   // Fail early, with the field.
   parts.policy = std::make_unique<sim::Policy>(sim::load_policy(options.policy, *parts.robot));
@@ -152,7 +152,8 @@ LauncherConfig launcher_config(const HilOptions& options, const sim::Robot& robo
   LauncherConfig lc;
   lc.endcap_binary = options.endcap_binary.empty() ? default_endcap_binary() : options.endcap_binary;
   lc.endcap_count = robot.endcap_count();
-  for (int e = 0; e < robot.endcap_count(); ++e) lc.motors_per_endcap.push_back(static_cast<int>(robot.cables_of(e).size()));
+  for (int e = 0; e < robot.endcap_count(); ++e)
+    lc.motors_per_endcap.push_back(static_cast<int>(robot.cables_of(e).size()));
   lc.hub_port = hub_port;
   lc.mode = options.mode;
   lc.loop_rate_hz = endcap_loop_rate_hz(robot);
@@ -187,9 +188,9 @@ void assemble(const HilOptions& options, RunParts& parts) {
   const LauncherConfig lc = launcher_config(options, robot, parts.hub->port());
   parts.launcher = std::make_unique<ProcessLauncher>(lc, *parts.provisioner);
   for (int e = 0; e < robot.endcap_count(); ++e) parts.hub->set_endcap_port(e, parts.launcher->endcap_port(e));
-  parts.stepper = std::make_unique<WorldStepper>(robot, sim::settled_state(robot, robot.time_step_s), *parts.hub,
-                                                 *parts.launcher, stepper_config(options, parts, lc.spool),
-                                                 parts.clock, options.stop);
+  parts.stepper =
+      std::make_unique<WorldStepper>(robot, sim::settled_state(robot, robot.time_step_s), *parts.hub, *parts.launcher,
+                                     stepper_config(options, parts, lc.spool), parts.clock, options.stop);
   parts.stepper->set_scenario(options.scenario);
   if (!options.record_csv.empty()) {
     parts.recorder = std::make_unique<Recorder>(options.record_csv, parts.stepper->model());

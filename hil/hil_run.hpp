@@ -39,7 +39,7 @@ struct HilOptions {
   double duration_s = 60.0;
   StepperMode mode = StepperMode::lockstep;
   Scenario scenario;
-  std::filesystem::path record_csv;  // empty: none
+  std::filesystem::path record_csv;     // empty: none
   std::filesystem::path endcap_binary;  // empty: default_endcap_binary()
   double barrier_timeout_s = 2.0;
   double max_speed = 0.0;  // lockstep: physics at most this many times real time (0: no limit)
@@ -49,13 +49,13 @@ struct HilOptions {
   int dds_domain = -1;                 // -1: a free one of the HIL's range (dds_domain.hpp)
   // dds: DDS Security keystore (created if missing); empty: unsecured (--insecure).
   std::filesystem::path dds_keystore;
-  double hold_timeout_s = 60.0;        // dds: gate open to physics step 0
+  double hold_timeout_s = 60.0;  // dds: gate open to physics step 0
   bool keep_dir = false;
   // dds: every end cap on the link, clock synchronized. Secured discovery (each pair
   // of 13 participants authenticates first) took 7-22 s lockstep, 24 s real time
   // here; below hold_timeout_s, so that a missing end cap is named.
   double dds_discovery_timeout_s = 45.0;
-  std::vector<int> never_start;  // tests
+  std::vector<int> never_start;                               // tests
   std::map<int, std::vector<std::string>> endcap_extra_args;  // tests: more arguments for an end cap
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).
   std::function<void(ProcessLauncher&)> after_launch;

@@ -25,6 +25,8 @@ inline std::int64_t endcap_period_ns(const sim::Robot& robot) {
   return static_cast<std::int64_t>(std::llround(dt * 1e9));
 }
 
-inline double endcap_loop_rate_hz(const sim::Robot& robot) { return 1e9 / static_cast<double>(endcap_period_ns(robot)); }
+inline double endcap_loop_rate_hz(const sim::Robot& robot) {
+  return 1e9 / static_cast<double>(endcap_period_ns(robot));
+}
 
 }  // namespace tensegrity::hil

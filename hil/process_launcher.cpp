@@ -37,7 +37,8 @@ fw::app::EndcapAppConfig endcap_config(const LauncherConfig& lc, int motors, std
   // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
   c.bus = "udp:127.0.0.1:" + std::to_string(lc.hub_port) + ",bind=127.0.0.1:" + std::to_string(port) + ",batch";
   c.motor_count = static_cast<std::uint32_t>(motors);
-  for (int m = 0; m < motors; ++m) c.drive_node_ids[static_cast<std::size_t>(m)] = kDriveNodeIds[static_cast<std::size_t>(m)];
+  for (int m = 0; m < motors; ++m)
+    c.drive_node_ids[static_cast<std::size_t>(m)] = kDriveNodeIds[static_cast<std::size_t>(m)];
   c.load_cell_node_id = kLoadCellNodeId;
   c.spool_radius_m = lc.spool.spool_radius_m;
   c.counts_per_rev = lc.spool.counts_per_rev;
@@ -115,8 +116,14 @@ void ProcessLauncher::start_all() {
 void ProcessLauncher::spawn(int e, bool restart) {
   Slot& s = slots_[e];
   // --hang-loop-signal: the hang_loop fault's test hook (SIGRTMIN), harmless unless sent.
-  std::vector<std::string> args{config_.endcap_binary.string(), "--id", std::to_string(e), "--config", s.config.string(),
-                                "--stats-json", s.stats.string(), "--hang-loop-signal"};
+  std::vector<std::string> args{config_.endcap_binary.string(),
+                                "--id",
+                                std::to_string(e),
+                                "--config",
+                                s.config.string(),
+                                "--stats-json",
+                                s.stats.string(),
+                                "--hang-loop-signal"};
   for (auto& a : provisioner_.endcap_arguments(e, restart)) args.push_back(std::move(a));
   if (const auto extra = config_.extra_args.find(e); extra != config_.extra_args.end()) {
     args.insert(args.end(), extra->second.begin(), extra->second.end());
@@ -222,7 +229,8 @@ std::string ProcessLauncher::describe(int e) {
       if (!line.empty()) last = line;
     }
     if (s.exit_status == -1) return "not started";
-    return "process exited with status " + std::to_string(s.exit_status) + (last.empty() ? "" : "; last log line: " + last);
+    return "process exited with status " + std::to_string(s.exit_status) +
+           (last.empty() ? "" : "; last log line: " + last);
   }
   std::ifstream in("/proc/" + std::to_string(s.pid) + "/stat");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

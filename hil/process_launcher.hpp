@@ -16,7 +16,6 @@
 #include <string>
 #include <vector>
 
-
 #include "firmware/app/endcap_stats.hpp"
 #include "firmware/core/limits.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
@@ -34,16 +33,16 @@ struct LauncherConfig {
   double loop_rate_hz = 1000.0;  // the end caps' loop: the robot's time step (loop_rate.hpp)
   fw::SpoolGeometry spool;
   core::MotorLimits limits;
-  bool keep_dir = false;          // leave configs, stores and logs behind (debugging)
-  std::vector<int> never_start;   // tests: end caps whose program is not started
+  bool keep_dir = false;                               // leave configs, stores and logs behind (debugging)
+  std::vector<int> never_start;                        // tests: end caps whose program is not started
   std::map<int, std::vector<std::string>> extra_args;  // tests: appended to an end cap's arguments
 };
 
 struct EndcapProcessReport {
   int endcap = 0;
   bool started = false;
-  int exit_status = -1;    // exit code, or -signal
-  double cpu_s = 0.0;      // user + system, read from /proc/PID/stat before the stop
+  int exit_status = -1;  // exit code, or -signal
+  double cpu_s = 0.0;    // user + system, read from /proc/PID/stat before the stop
   std::uint64_t restarts = 0;
   // The program's --stats-json of its last incarnation (final, or the last
   // once-a-second snapshot of one that was killed); absent if none was readable.

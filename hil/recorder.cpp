@@ -13,7 +13,8 @@ Recorder::Recorder(const std::filesystem::path& path, const sim::Model& model) :
   for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",tension_n_%d", c);
   // Every end cap's position and the energies, named as in `tensegrity sim
   // --telemetry`: what `tensegrity view` needs to draw the robot.
-  for (int i = 0; i < model.robot().node_count(); ++i) std::fprintf(file_, ",node%d_x_m,node%d_y_m,node%d_z_m", i, i, i);
+  for (int i = 0; i < model.robot().node_count(); ++i)
+    std::fprintf(file_, ",node%d_x_m,node%d_y_m,node%d_z_m", i, i, i);
   std::fputs(",kinetic_energy_j,gravity_energy_j,elastic_energy_j", file_);
   std::fputc('\n', file_);
 }

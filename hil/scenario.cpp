@@ -44,7 +44,8 @@ FaultKind fault_from_name(const std::string& name, const std::string& where) {
 
 void check_endcap(int endcap, int endcap_count, const std::string& where) {
   if (endcap < 0 || endcap >= endcap_count) {
-    throw HilError(where + ": endcap " + std::to_string(endcap) + " out of range 0.." + std::to_string(endcap_count - 1));
+    throw HilError(where + ": endcap " + std::to_string(endcap) + " out of range 0.." +
+                   std::to_string(endcap_count - 1));
   }
 }
 
@@ -55,7 +56,8 @@ FaultParams parse_params(const nlohmann::json& p, const std::string& where) {
   for (const auto& [key, value] : p.items()) {
     const std::string at = where + ".params." + key;
     if (key == "motor") {
-      if (!value.is_number_integer() || value.get<int>() < -1 || value.get<int>() > 3) throw HilError(at + ": an integer -1..3");
+      if (!value.is_number_integer() || value.get<int>() < -1 || value.get<int>() > 3)
+        throw HilError(at + ": an integer -1..3");
       out.motor = value.get<int>();
     } else if (key == "code") {
       if (!value.is_number_unsigned() || value.get<unsigned>() > 0xFFFF) throw HilError(at + ": an integer 0..65535");
@@ -67,7 +69,8 @@ FaultParams parse_params(const nlohmann::json& p, const std::string& where) {
       if (!value.is_number()) throw HilError(at + ": a number");
       out.n_per_s = value.get<double>();
     } else if (key == "probability") {
-      if (!value.is_number() || value.get<double>() < 0.0 || value.get<double>() > 1.0) throw HilError(at + ": a number 0..1");
+      if (!value.is_number() || value.get<double>() < 0.0 || value.get<double>() > 1.0)
+        throw HilError(at + ": a number 0..1");
       out.probability = value.get<double>();
     } else if (key == "duration_s") {
       if (!value.is_number() || value.get<double>() < 0.0) throw HilError(at + ": a number >= 0");
@@ -98,8 +101,8 @@ const char* to_string(FaultKind kind) {
 
 std::string ScenarioEvent::describe() const {
   std::ostringstream s;
-  s << "t=" << time_s << " s " << (endcap < 0 ? std::string("all end caps") : "end cap " + std::to_string(endcap)) << ": "
-    << to_string(fault);
+  s << "t=" << time_s << " s " << (endcap < 0 ? std::string("all end caps") : "end cap " + std::to_string(endcap))
+    << ": " << to_string(fault);
   switch (fault) {
     case FaultKind::drive_fault:
       s << " (motor " << params.motor << ", EMCY 0x" << std::hex << params.code << std::dec
@@ -112,8 +115,8 @@ std::string ScenarioEvent::describe() const {
     case FaultKind::load_cell_drift: s << " (" << params.n_per_s << " N/s)"; break;
     case FaultKind::drop_frames:
     case FaultKind::corrupt_frames:
-      s << " (p " << params.probability << ", " << (params.duration_s > 0 ? std::to_string(params.duration_s) + " s" : "to the end")
-        << ")";
+      s << " (p " << params.probability << ", "
+        << (params.duration_s > 0 ? std::to_string(params.duration_s) + " s" : "to the end") << ")";
       break;
     default: break;
   }
@@ -185,7 +188,8 @@ Scenario load_scenario(const std::filesystem::path& path, int endcap_count) {
 
 ScenarioEvent disabled_cable_event(const sim::Robot& robot, int cable, CableFailure failure) {
   if (cable < 0 || cable >= robot.cable_count()) {
-    throw HilError("cable " + std::to_string(cable) + ": the robot has cables 0.." + std::to_string(robot.cable_count() - 1));
+    throw HilError("cable " + std::to_string(cable) + ": the robot has cables 0.." +
+                   std::to_string(robot.cable_count() - 1));
   }
   ScenarioEvent ev;
   ev.time_s = 0.0;

@@ -40,15 +40,15 @@ enum class FaultKind : std::uint8_t {
 const char* to_string(FaultKind kind);
 
 struct FaultParams {
-  int motor = 0;              // -1: every motor of the end cap
+  int motor = 0;                // -1: every motor of the end cap
   std::uint16_t code = 0x2310;  // EMCY error code (0x2310: continuous over-current)
   // A released drive lets its spool run free (brake off): the cable pays out to the
   // spool's end stop, the maximum rest length, and goes slack. Default: the drive
   // holds its cable (brake on), which is what a faulted CiA 402 drive does.
   bool release = false;
-  double n_per_s = 5.0;       // load-cell drift
-  double probability = 0.1;   // drop/corrupt
-  double duration_s = 0.0;    // drop/corrupt: 0 = until the end
+  double n_per_s = 5.0;      // load-cell drift
+  double probability = 0.1;  // drop/corrupt
+  double duration_s = 0.0;   // drop/corrupt: 0 = until the end
   CorruptKind corrupt_kind = CorruptKind::frame;
 };
 

@@ -38,7 +38,8 @@ std::int64_t TickSource::barrier(TickAnswers& answers, Expect expect, std::int64
     }
   }
   const std::int64_t end = clock_.now_ns();
-  if (expect != Expect::nothing) nap_.observe((answers.latest_arrival_ns() > 0 ? answers.latest_arrival_ns() : end) - start);
+  if (expect != Expect::nothing)
+    nap_.observe((answers.latest_arrival_ns() > 0 ? answers.latest_arrival_ns() : end) - start);
   return end - start;
 }
 

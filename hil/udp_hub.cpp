@@ -180,8 +180,7 @@ void UdpHub::flush() {
   }
 }
 
-void UdpHub::take_datagram(int e, std::span<const std::uint8_t> datagram, std::vector<Rx>& out,
-                           std::size_t& appended) {
+void UdpHub::take_datagram(int e, std::span<const std::uint8_t> datagram, std::vector<Rx>& out, std::size_t& appended) {
   Endcap& ec = endcaps_[e];
   ++ec.counters.rx_datagrams;
   const fw::udp_can::DatagramReader reader(datagram);

@@ -32,14 +32,14 @@
 namespace tensegrity::hil {
 
 struct BusCounters {
-  std::uint64_t tx_frames = 0;        // datagrams sent to the end cap
-  std::uint64_t rx_frames = 0;        // good frames from the end cap
-  std::uint64_t rx_malformed = 0;     // datagrams from it that failed the wire checks
-  std::uint64_t injected_drops = 0;   // frames to it dropped on purpose
-  std::uint64_t injected_corrupt = 0; // frames to it corrupted on purpose
-  std::uint64_t tx_errors = 0;        // frames sendmmsg refused (buffer full, port closed)
-  std::uint64_t tx_datagrams = 0;     // datagrams those frames travelled in
-  std::uint64_t rx_datagrams = 0;     // datagrams from the end cap
+  std::uint64_t tx_frames = 0;         // datagrams sent to the end cap
+  std::uint64_t rx_frames = 0;         // good frames from the end cap
+  std::uint64_t rx_malformed = 0;      // datagrams from it that failed the wire checks
+  std::uint64_t injected_drops = 0;    // frames to it dropped on purpose
+  std::uint64_t injected_corrupt = 0;  // frames to it corrupted on purpose
+  std::uint64_t tx_errors = 0;         // frames sendmmsg refused (buffer full, port closed)
+  std::uint64_t tx_datagrams = 0;      // datagrams those frames travelled in
+  std::uint64_t rx_datagrams = 0;      // datagrams from the end cap
 };
 
 enum class CorruptKind : std::uint8_t {
@@ -113,7 +113,7 @@ class UdpHub {
     std::size_t frames() const { return batch ? writer.count() : 1; }
   };
   using RxBuffer = std::array<std::uint8_t, fw::udp_can::kMaxDatagramBytes + 1>;  // one more: oversize shows
-  struct Control {  // room for one SCM_TIMESTAMPNS
+  struct Control {                                                                // room for one SCM_TIMESTAMPNS
     alignas(8) char bytes[64];
   };
   void take_datagram(int endcap, std::span<const std::uint8_t> datagram, std::vector<Rx>& out, std::size_t& appended);
@@ -123,9 +123,9 @@ class UdpHub {
   std::uint16_t port_ = 0;
   std::vector<Endcap> endcaps_;
   std::vector<Pending> pending_;
-  std::vector<Outgoing> outgoing_;     // reused by flush(); grows, never shrinks
-  std::vector<int> open_batch_;        // per end cap: its batch in outgoing_, -1 none
-  std::vector<RxBuffer> rx_buffers_;   // recvmmsg's buffers, made once
+  std::vector<Outgoing> outgoing_;    // reused by flush(); grows, never shrinks
+  std::vector<int> open_batch_;       // per end cap: its batch in outgoing_, -1 none
+  std::vector<RxBuffer> rx_buffers_;  // recvmmsg's buffers, made once
   std::mt19937_64 rng_;
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
   std::uint64_t rx_unknown_sender_ = 0;

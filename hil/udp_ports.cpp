@@ -58,8 +58,8 @@ std::vector<std::uint16_t> free_udp_ports(int count) {
   }
   release();
   if (static_cast<int>(ports.size()) < count) {
-    throw HilError("cannot find " + std::to_string(count) + " free UDP ports in 127.0.0.1:" + std::to_string(low) + ".." +
-                   std::to_string(high - 1));
+    throw HilError("cannot find " + std::to_string(count) + " free UDP ports in 127.0.0.1:" + std::to_string(low) +
+                   ".." + std::to_string(high - 1));
   }
   return ports;
 }

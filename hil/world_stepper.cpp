@@ -21,8 +21,7 @@ const char* to_string(StepperMode mode) { return mode == StepperMode::lockstep ?
 double StepperStats::sim_time_s() const { return static_cast<double>(steps) * dt_s; }
 
 WorldStepper::WorldStepper(const sim::Robot& robot, const sim::ModelState& start, UdpHub& hub,
-                           EndcapProcesses& processes, const StepperConfig& config, Clock& clock,
-                           std::stop_token stop)
+                           EndcapProcesses& processes, const StepperConfig& config, Clock& clock, std::stop_token stop)
     : model_(std::make_unique<sim::Model>(robot, robot.time_step_s)),
       hub_(hub),
       config_(config),
@@ -110,8 +109,9 @@ void WorldStepper::lockstep_tick(bool physics) {
   const auto expect = !roster_.any_expected() ? TickSource::Expect::nothing
                       : first                 ? TickSource::Expect::first_answers
                                               : TickSource::Expect::usual;
-  const std::int64_t waited = source_.barrier(*this, expect, first ? config_.first_answer_timeout_ns : config_.barrier_timeout_ns,
-                                              ticks_, started_ ? stats_.steps : -1);
+  const std::int64_t waited =
+      source_.barrier(*this, expect, first ? config_.first_answer_timeout_ns : config_.barrier_timeout_ns, ticks_,
+                      started_ ? stats_.steps : -1);
   roster_.answered();
   stats_.max_barrier_wait_s = std::max(stats_.max_barrier_wait_s, ns_to_s(waited));
   const std::int64_t t_physics = clock.now_ns();

@@ -94,11 +94,11 @@ struct StepperStats {
   std::int64_t steps = 0;  // physics steps
   double boot_wall_s = 0.0;
   double run_wall_s = 0.0;
-  std::int64_t late_steps = 0;     // realtime: began > half a period after its deadline (lateness.hpp)
+  std::int64_t late_steps = 0;  // realtime: began > half a period after its deadline (lateness.hpp)
   double max_lateness_s = 0.0;
-  LatenessSummary lateness;        // realtime: the whole distribution
+  LatenessSummary lateness;         // realtime: the whole distribution
   double max_barrier_wait_s = 0.0;  // lockstep: longest wait for the end caps' answers
-  std::int64_t rejoins = 0;        // gates opened after the start (restart, reset)
+  std::int64_t rejoins = 0;         // gates opened after the start (restart, reset)
   double max_tension_n = 0.0;
   // Lockstep wall-time breakdown of the run phase: sending (sensor PDOs + SYNC),
   // waiting for and serving the end caps' answers, the physics step.
@@ -161,7 +161,7 @@ class WorldStepper final : private TickAnswers {
   std::int64_t now_device_ns() const { return ticks_ * source_.period_ns(); }
   bool pass_gate(int endcap);  // lockstep: a gate after the start opens on a period boundary
   void lockstep_tick(bool physics);
-  void send_tick(int endcap, bool sync);  // due frames (+ sensors and SYNC) to one live end cap
+  void send_tick(int endcap, bool sync);          // due frames (+ sensors and SYNC) to one live end cap
   void serve(const std::vector<UdpHub::Rx>& rx);  // frames to the devices, answers queued
   void physics_step();
   void apply_faults();

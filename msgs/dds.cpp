@@ -64,7 +64,8 @@ dds::DomainParticipant* create_participant(int domain, const std::string& name, 
   if (link_cut != nullptr) {
     for (auto& transport : qos.transport().user_transports) transport = make_link_cut_transport(transport, link_cut);
   }
-  dds::DomainParticipant* participant = factory->create_participant(static_cast<dds::DomainId_t>(domain), qos, listener, dds::StatusMask::none());
+  dds::DomainParticipant* participant =
+      factory->create_participant(static_cast<dds::DomainId_t>(domain), qos, listener, dds::StatusMask::none());
   if (participant == nullptr) {
     throw DdsError("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain) +
                    (enclave_dir.empty() ? std::string()
@@ -102,16 +103,16 @@ dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& s
   return topic;
 }
 
-dds::DataWriter* create_writer(dds::DomainParticipant& participant, dds::Publisher& publisher,
-                               const TopicSpec& spec, dds::TypeSupport type) {
+dds::DataWriter* create_writer(dds::DomainParticipant& participant, dds::Publisher& publisher, const TopicSpec& spec,
+                               dds::TypeSupport type) {
   dds::Topic* topic = create_topic(participant, spec, type);
   dds::DataWriter* writer = publisher.create_datawriter_with_profile(topic, spec.profile);
   if (writer == nullptr) throw DdsError(std::string("cannot create writer on ") + spec.name);
   return writer;
 }
 
-dds::DataReader* create_reader(dds::DomainParticipant& participant, dds::Subscriber& subscriber,
-                               const TopicSpec& spec, dds::TypeSupport type, dds::DataReaderListener* listener) {
+dds::DataReader* create_reader(dds::DomainParticipant& participant, dds::Subscriber& subscriber, const TopicSpec& spec,
+                               dds::TypeSupport type, dds::DataReaderListener* listener) {
   dds::Topic* topic = create_topic(participant, spec, type);
   dds::DataReader* reader = subscriber.create_datareader_with_profile(topic, spec.profile, listener);
   if (reader == nullptr) throw DdsError(std::string("cannot create reader on ") + spec.name);

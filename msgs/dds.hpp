@@ -59,20 +59,29 @@ struct TopicSpec {
   Writer writer;
 };
 
-inline constexpr TopicSpec kPolicyTableTopic{"rt/tensegrity/policy_table", "tensegrity_msgs::msg::dds_::PolicyTable_", kProfileDurable, Writer::ground};
-inline constexpr TopicSpec kPolicyAckTopic{"rt/tensegrity/policy_ack", "tensegrity_msgs::msg::dds_::PolicyAck_", kProfileDurable, Writer::endcap};
-inline constexpr TopicSpec kCommandTopic{"rt/tensegrity/command", "tensegrity_msgs::msg::dds_::Command_", kProfileDurable, Writer::ground};
-inline constexpr TopicSpec kCommandAckTopic{"rt/tensegrity/command_ack", "tensegrity_msgs::msg::dds_::CommandAck_", kProfileDurable, Writer::endcap};
-inline constexpr TopicSpec kTelemetryTopic{"rt/tensegrity/telemetry", "tensegrity_msgs::msg::dds_::Telemetry_", kProfileStream, Writer::endcap};
-inline constexpr TopicSpec kHostHeartbeatTopic{"rt/tensegrity/host_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream, Writer::ground};
-inline constexpr TopicSpec kEndcapHeartbeatTopic{"rt/tensegrity/endcap_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream, Writer::endcap};
-inline constexpr TopicSpec kTimeSyncRequestTopic{"rt/tensegrity/time_sync_request", "tensegrity_msgs::msg::dds_::TimeSyncRequest_", kProfileTimeSync, Writer::endcap};
-inline constexpr TopicSpec kTimeSyncReplyTopic{"rt/tensegrity/time_sync_reply", "tensegrity_msgs::msg::dds_::TimeSyncReply_", kProfileTimeSync, Writer::ground};
+inline constexpr TopicSpec kPolicyTableTopic{"rt/tensegrity/policy_table", "tensegrity_msgs::msg::dds_::PolicyTable_",
+                                             kProfileDurable, Writer::ground};
+inline constexpr TopicSpec kPolicyAckTopic{"rt/tensegrity/policy_ack", "tensegrity_msgs::msg::dds_::PolicyAck_",
+                                           kProfileDurable, Writer::endcap};
+inline constexpr TopicSpec kCommandTopic{"rt/tensegrity/command", "tensegrity_msgs::msg::dds_::Command_",
+                                         kProfileDurable, Writer::ground};
+inline constexpr TopicSpec kCommandAckTopic{"rt/tensegrity/command_ack", "tensegrity_msgs::msg::dds_::CommandAck_",
+                                            kProfileDurable, Writer::endcap};
+inline constexpr TopicSpec kTelemetryTopic{"rt/tensegrity/telemetry", "tensegrity_msgs::msg::dds_::Telemetry_",
+                                           kProfileStream, Writer::endcap};
+inline constexpr TopicSpec kHostHeartbeatTopic{"rt/tensegrity/host_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_",
+                                               kProfileStream, Writer::ground};
+inline constexpr TopicSpec kEndcapHeartbeatTopic{
+    "rt/tensegrity/endcap_heartbeat", "tensegrity_msgs::msg::dds_::Heartbeat_", kProfileStream, Writer::endcap};
+inline constexpr TopicSpec kTimeSyncRequestTopic{"rt/tensegrity/time_sync_request",
+                                                 "tensegrity_msgs::msg::dds_::TimeSyncRequest_", kProfileTimeSync,
+                                                 Writer::endcap};
+inline constexpr TopicSpec kTimeSyncReplyTopic{
+    "rt/tensegrity/time_sync_reply", "tensegrity_msgs::msg::dds_::TimeSyncReply_", kProfileTimeSync, Writer::ground};
 
-inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic, kPolicyAckTopic, kCommandTopic,
-                                                     kCommandAckTopic, kTelemetryTopic, kHostHeartbeatTopic,
-                                                     kEndcapHeartbeatTopic, kTimeSyncRequestTopic,
-                                                     kTimeSyncReplyTopic};
+inline constexpr std::array<TopicSpec, 9> kAllTopics{kPolicyTableTopic,     kPolicyAckTopic,       kCommandTopic,
+                                                     kCommandAckTopic,      kTelemetryTopic,       kHostHeartbeatTopic,
+                                                     kEndcapHeartbeatTopic, kTimeSyncRequestTopic, kTimeSyncReplyTopic};
 
 // Loads the QoS profiles once per process: TENSEGRITY_QOS_FILE if set, else the
 // copy compiled in. Throws DdsError when Fast DDS rejects the XML.
@@ -89,7 +98,8 @@ void load_qos_profiles();
 // (no status callbacks: the readers' own listeners keep those); it must outlive it.
 eprosima::fastdds::dds::DomainParticipant* create_participant(
     int domain, const std::string& name, const std::atomic<bool>* link_cut = nullptr,
-    const std::filesystem::path& enclave_dir = {}, eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
+    const std::filesystem::path& enclave_dir = {},
+    eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
 void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
 
 // Registers `type` (once per participant) and creates the topic of `spec` (or
@@ -101,11 +111,11 @@ eprosima::fastdds::dds::Topic* create_topic(eprosima::fastdds::dds::DomainPartic
 // (the end cap's node and the ground station) create theirs through these.
 // Throw DdsError naming the topic.
 eprosima::fastdds::dds::DataWriter* create_writer(eprosima::fastdds::dds::DomainParticipant& participant,
-                                                  eprosima::fastdds::dds::Publisher& publisher,
-                                                  const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type);
+                                                  eprosima::fastdds::dds::Publisher& publisher, const TopicSpec& spec,
+                                                  eprosima::fastdds::dds::TypeSupport type);
 eprosima::fastdds::dds::DataReader* create_reader(eprosima::fastdds::dds::DomainParticipant& participant,
-                                                  eprosima::fastdds::dds::Subscriber& subscriber,
-                                                  const TopicSpec& spec, eprosima::fastdds::dds::TypeSupport type,
+                                                  eprosima::fastdds::dds::Subscriber& subscriber, const TopicSpec& spec,
+                                                  eprosima::fastdds::dds::TypeSupport type,
                                                   eprosima::fastdds::dds::DataReaderListener* listener);
 
 }  // namespace tensegrity::msgs

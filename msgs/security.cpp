@@ -46,7 +46,7 @@ fs::path default_keystore() {
 }
 
 EnclaveFiles enclave_files(const fs::path& dir) {
-  return EnclaveFiles{dir / "identity_ca.cert.pem", dir / "cert.pem",        dir / "key.pem",
+  return EnclaveFiles{dir / "identity_ca.cert.pem",    dir / "cert.pem",       dir / "key.pem",
                       dir / "permissions_ca.cert.pem", dir / "governance.p7s", dir / "permissions.p7s"};
 }
 
@@ -115,7 +115,8 @@ std::string governance_xml() {
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_governance.xsd">
   <domain_access_rules>
     <domain_rule>
-      )") + kDomains + R"(
+      )") +
+         kDomains + R"(
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
       <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
@@ -164,7 +165,8 @@ std::string permission_rules(const std::string& enclave) {
       publish_partitions = "<partitions><partition>" + endcap_partition(who.endcap_id) + "</partition></partitions>";
       break;
     case Role::ground:
-      subscribe_partitions = std::string("<partitions><partition>") + kEveryEndcapPartition + "</partition></partitions>";
+      subscribe_partitions =
+          std::string("<partitions><partition>") + kEveryEndcapPartition + "</partition></partitions>";
       break;
     case Role::listener:
       // What a ROS 2 node publishes of its own (graph, log, parameters, services),
@@ -186,10 +188,14 @@ std::string permissions_xml(const std::string& enclave, const std::string& not_b
   return R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_permissions.xsd">
   <permissions>
-    <grant name=")" + enclave + R"(">
-      <subject_name>)" + subject_name(enclave) + R"(</subject_name>
-      <validity><not_before>)" + not_before + "</not_before><not_after>" + not_after + R"(</not_after></validity>
-      )" + rule + R"(
+    <grant name=")" +
+         enclave + R"(">
+      <subject_name>)" +
+         subject_name(enclave) + R"(</subject_name>
+      <validity><not_before>)" +
+         not_before + "</not_before><not_after>" + not_after + R"(</not_after></validity>
+      )" +
+         rule + R"(
       <default>DENY</default>
     </grant>
   </permissions>

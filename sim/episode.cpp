@@ -185,8 +185,7 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
     result.axial_spin_rms_rad_per_s = std::sqrt(spin_sq_sum / (static_cast<double>(done) * std::max(1, struts)));
     result.endcaps_touched_ground = std::popcount(touched);
   }
-  result.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;
 }
 

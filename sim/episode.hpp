@@ -34,8 +34,8 @@ struct EpisodeResult {
   std::string infeasible_reason;
   double infeasible_time_s = 0.0;
   double max_tension_n = 0.0;
-  double mean_tension_n = 0.0;   // over time and cables
-  double motor_energy_j = 0.0;   // work the motors did shortening cables under tension
+  double mean_tension_n = 0.0;      // over time and cables
+  double motor_energy_j = 0.0;      // work the motors did shortening cables under tension
   double mean_motor_power_w = 0.0;  // per cable
   // How the struts turned about their own axes (a gait must not skate on spinning
   // struts, docs/model.md): RMS over struts and steps, and the largest seen.

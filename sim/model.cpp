@@ -45,7 +45,6 @@ using ode_detail::vec;
 
 }  // namespace
 
-
 Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_(std::make_unique<Ode>()) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
   init_ode_for_this_thread();
@@ -116,9 +115,7 @@ void Model::init_surface_attachments() {
   }
 }
 
-void Model::set_gravity_enabled(bool on) {
-  dWorldSetGravity(ode_->world, 0, 0, on ? -robot_.gravity_m_per_s2 : 0.0);
-}
+void Model::set_gravity_enabled(bool on) { dWorldSetGravity(ode_->world, 0, 0, on ? -robot_.gravity_m_per_s2 : 0.0); }
 
 void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
   for (std::size_t s = 0; s < robot_.struts.size(); ++s) {
@@ -151,8 +148,7 @@ ModelState Model::save() const {
     const dReal* q = dBodyGetQuaternion(body);
     const dReal* v = dBodyGetLinearVel(body);
     const dReal* w = dBodyGetAngularVel(body);
-    state.body.insert(state.body.end(), {p[0], p[1], p[2], q[0], q[1], q[2], q[3], v[0], v[1],
-                                         v[2], w[0], w[1], w[2]});
+    state.body.insert(state.body.end(), {p[0], p[1], p[2], q[0], q[1], q[2], q[3], v[0], v[1], v[2], w[0], w[1], w[2]});
   }
   state.rest_length_m = rest_length_m_;
   state.tension_n = tension_n_;
@@ -160,8 +156,7 @@ ModelState Model::save() const {
 }
 
 void Model::restore(const ModelState& state) {
-  if (state.body.size() != ode_->bodies.size() * 13 ||
-      state.rest_length_m.size() != rest_length_m_.size()) {
+  if (state.body.size() != ode_->bodies.size() * 13 || state.rest_length_m.size() != rest_length_m_.size()) {
     throw RobotError("model: snapshot does not match this robot");
   }
   for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {

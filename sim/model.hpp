@@ -62,8 +62,7 @@ class Model {
   double elastic_energy_j() const;
   // Strut spin about its own axis, rad/s.
   double axial_spin_rad_per_s(int strut) const;
-  void set_velocity(int strut, const Eigen::Vector3d& linear_m_per_s,
-                    const Eigen::Vector3d& angular_rad_per_s);
+  void set_velocity(int strut, const Eigen::Vector3d& linear_m_per_s, const Eigen::Vector3d& angular_rad_per_s);
   bool state_finite() const;
   // The integration blew up (non-finite or absurd speeds); the model stops stepping.
   bool diverged() const { return diverged_; }
@@ -92,8 +91,7 @@ class Model {
   std::vector<double> half_length_m_;
   std::vector<int> strut_of_node_;
   std::vector<double> end_sign_of_node_;
-  std::vector<double> rest_length_m_, length_m_, length_rate_m_per_s_, tension_n_,
-      rest_rate_m_per_s_;
+  std::vector<double> rest_length_m_, length_m_, length_rate_m_per_s_, tension_n_, rest_rate_m_per_s_;
   // Per node: world position, velocity, and arm from its strut's centre; per cable
   // the unit vector from node a to node b.
   std::vector<Eigen::Vector3d> node_pos_, node_vel_, node_arm_, unit_, force_, torque_;

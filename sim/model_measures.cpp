@@ -14,8 +14,7 @@ using ode_detail::vec;
 Eigen::Vector3d Model::node_position(int node) const {
   const int s = strut_of_node_[node];
   dBodyID body = ode_->bodies[s];
-  return vec(dBodyGetPosition(body)) +
-         (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
+  return vec(dBodyGetPosition(body)) + (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
 }
 
 std::vector<Eigen::Vector3d> Model::node_positions() const {

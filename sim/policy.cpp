@@ -82,8 +82,9 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
   const json& cables = need(doc, "cables", source, "");
   if (!cables.is_array()) fail(source, "cables", "must be an array");
   if (static_cast<int>(cables.size()) != robot.cable_count()) {
-    fail(source, "cables", "has " + std::to_string(cables.size()) + " entries, the robot has " +
-                               std::to_string(robot.cable_count()) + " cables");
+    fail(source, "cables",
+         "has " + std::to_string(cables.size()) + " entries, the robot has " + std::to_string(robot.cable_count()) +
+             " cables");
   }
   policy.cables.resize(cables.size());
   std::vector<bool> seen(cables.size(), false);
@@ -98,9 +99,9 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
     cable.cable = static_cast<int>(index);
     const long long owner = integer(need(entry, "owner", source, path), source, path + ".owner");
     if (owner != robot.cables[index].owner) {
-      fail(source, path + ".owner", "cable " + std::to_string(index) + " is owned by end cap " +
-                                        std::to_string(robot.cables[index].owner) + ", not " +
-                                        std::to_string(owner));
+      fail(source, path + ".owner",
+           "cable " + std::to_string(index) + " is owned by end cap " + std::to_string(robot.cables[index].owner) +
+               ", not " + std::to_string(owner));
     }
     cable.owner = static_cast<int>(owner);
     const json& values = need(entry, "rest_lengths_m", source, path);
@@ -124,7 +125,8 @@ Policy parse_policy(const std::string& json_text, const Robot& robot, const std:
     const json& p = *it;
     if (!p.is_object()) fail(source, "provenance", "must be an object");
     policy.provenance.method = p.value("method", "");
-    if (p.contains("seed")) policy.provenance.seed = static_cast<std::uint64_t>(integer(p["seed"], source, "provenance.seed"));
+    if (p.contains("seed"))
+      policy.provenance.seed = static_cast<std::uint64_t>(integer(p["seed"], source, "provenance.seed"));
     if (p.contains("episodes")) policy.provenance.episodes = integer(p["episodes"], source, "provenance.episodes");
     if (p.contains("score_m")) policy.provenance.score_m = finite_number(p["score_m"], source, "provenance.score_m");
     policy.provenance.robot_hash = p.value("robot_hash", "");
@@ -198,9 +200,11 @@ std::string policy_to_json(const Policy& policy) {
   };
   const Provenance& pr = policy.provenance;
   if (pr.sigma_m > 0.0) {
-    doc["provenance"]["mutation"] = {
-        {"operator", pr.mutation}, {"sigma_m", pr.sigma_m}, {"sigma_final_m", pr.sigma_final_m}, {"anneal_start_episodes", pr.anneal_start_episodes},
-        {"anneal_episodes", pr.anneal_episodes}};
+    doc["provenance"]["mutation"] = {{"operator", pr.mutation},
+                                     {"sigma_m", pr.sigma_m},
+                                     {"sigma_final_m", pr.sigma_final_m},
+                                     {"anneal_start_episodes", pr.anneal_start_episodes},
+                                     {"anneal_episodes", pr.anneal_episodes}};
   }
   if (pr.endcaps_touched_ground >= 0) {
     doc["provenance"]["gait"] = {{"axial_spin_rms_rad_per_s", pr.axial_spin_rms_rad_per_s},

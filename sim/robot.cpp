@@ -36,9 +36,7 @@ class Reader {
   }
   bool has(const std::string& field) const { return j_.is_object() && j_.contains(field); }
   double number(const std::string& field) const { return as_number(at(field), field); }
-  double number_or(const std::string& field, double fallback) const {
-    return has(field) ? number(field) : fallback;
-  }
+  double number_or(const std::string& field, double fallback) const { return has(field) ? number(field) : fallback; }
   double as_number(const json& v, const std::string& field) const {
     if (!v.is_number()) fail(field, "must be a number");
     const double x = v.get<double>();
@@ -76,8 +74,7 @@ class Reader {
     if (!v.is_number_integer()) fail(field, "must be a node index (integer)");
     const auto i = v.get<long long>();
     if (i < 0 || i >= node_count) {
-      fail(field, "node " + std::to_string(i) + " does not exist (" + std::to_string(node_count) +
-                      " nodes)");
+      fail(field, "node " + std::to_string(i) + " does not exist (" + std::to_string(node_count) + " nodes)");
     }
     return static_cast<int>(i);
   }
@@ -96,8 +93,7 @@ constexpr double kMaxStrutLengthM = 20.0;
 constexpr double kMaxStrutMassKg = 1000.0;
 constexpr double kMaxStrutRadiusM = 1.0;
 
-void check_pair(const Reader& r, const json& pair, const std::string& field, int node_count,
-                int& a, int& b) {
+void check_pair(const Reader& r, const json& pair, const std::string& field, int node_count, int& a, int& b) {
   if (!pair.is_array() || pair.size() != 2) r.fail(field, "must be a pair of node indices");
   a = r.node_index(pair[0], field + "[0]", node_count);
   b = r.node_index(pair[1], field + "[1]", node_count);
@@ -189,8 +185,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
     check_pair(r, struts[i], field, n, s.node_a, s.node_b);
     for (const int node : {s.node_a, s.node_b}) {
       if (strut_of[node] >= 0) {
-        r.fail(field, "node " + std::to_string(node) + " is already an end of struts[" +
-                          std::to_string(strut_of[node]) + "]");
+        r.fail(field,
+               "node " + std::to_string(node) + " is already an end of struts[" + std::to_string(strut_of[node]) + "]");
       }
       strut_of[node] = static_cast<int>(i);
     }
@@ -236,8 +232,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
     CableSpec spec;
     check_pair(r, c.at("nodes"), field + ".nodes", n, spec.node_a, spec.node_b);
     if (strut_of[spec.node_a] == strut_of[spec.node_b]) {
-      c.fail("nodes", "both ends are on struts[" + std::to_string(strut_of[spec.node_a]) +
-                          "]: a cable must join two struts");
+      c.fail("nodes",
+             "both ends are on struts[" + std::to_string(strut_of[spec.node_a]) + "]: a cable must join two struts");
     }
     const auto key = std::minmax(spec.node_a, spec.node_b);
     if (!seen.insert(key).second) c.fail("nodes", "duplicate cable between these nodes");

@@ -32,8 +32,7 @@ void CsvTelemetry::record(double time_s, const Model& model) {
   const auto tension = model.tension_n();
   const auto rate = model.rest_length_rate_m_per_s();
   for (int m = 0; m < model.cable_count(); ++m) out_ << ',' << tension[m] * rate[m];
-  out_ << ',' << model.kinetic_energy_j() << ',' << model.gravity_energy_j() << ','
-       << model.elastic_energy_j() << '\n';
+  out_ << ',' << model.kinetic_energy_j() << ',' << model.gravity_energy_j() << ',' << model.elastic_energy_j() << '\n';
 }
 
 void CsvTelemetry::end() {

@@ -93,8 +93,9 @@ CsvReadResult read_numeric_csv(const std::filesystem::path& path, CsvHeader& hea
     if (line_no == 1) {
       header.names = split_names(line);
       if (header.find("time_s") != 0) {
-        throw InputError(header.source + ":1:1: the first column must be time_s (a telemetry CSV of `tensegrity sim "
-                                         "--telemetry` or `tensegrity hil --record`)");
+        throw InputError(header.source +
+                         ":1:1: the first column must be time_s (a telemetry CSV of `tensegrity sim "
+                         "--telemetry` or `tensegrity hil --record`)");
       }
       continue;
     }

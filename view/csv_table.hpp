@@ -27,7 +27,7 @@ struct CsvHeader {
 };
 
 struct CsvReadResult {
-  std::size_t rows = 0;           // data rows read (all, kept or not)
+  std::size_t rows = 0;               // data rows read (all, kept or not)
   std::vector<std::string> warnings;  // e.g. a last line cut mid-write, dropped
 };
 

@@ -35,8 +35,7 @@ struct EvolveWatch::State {
   std::string replay;
 };
 
-EvolveWatch::EvolveWatch(const EvolveWatchOptions& options)
-    : options_(options), state_(std::make_unique<State>()) {
+EvolveWatch::EvolveWatch(const EvolveWatchOptions& options) : options_(options), state_(std::make_unique<State>()) {
   state_->message = "no checkpoint yet in " + options.dir.string() + " (tensegrity evolve --checkpoint DIR)";
   thread_ = std::thread([this] { loop(); });
 }
@@ -162,8 +161,11 @@ void EvolveWatch::loop() {
 std::string EvolveWatch::curve_json() const {
   std::lock_guard lock(mutex_);
   const State& s = *state_;
-  nlohmann::json j{{"dir", options_.dir.string()}, {"state", s.status}, {"message", s.message},
-                   {"best_version", s.best_version}, {"replay_version", s.replay_version}};
+  nlohmann::json j{{"dir", options_.dir.string()},
+                   {"state", s.status},
+                   {"message", s.message},
+                   {"best_version", s.best_version},
+                   {"replay_version", s.replay_version}};
   if (s.have && s.status != "error") {
     const auto& st = s.checkpoint.state;
     j["generation"] = st.generation;
@@ -172,8 +174,10 @@ std::string EvolveWatch::curve_json() const {
     j["method"] = evo::to_string(s.checkpoint.config.method);
     j["best_score_m"] = st.best.score_m;
     j["best_generation"] = st.best.generation;
-    nlohmann::json curve{{"generation", nlohmann::json::array()}, {"best_score_m", nlohmann::json::array()},
-                         {"mean_score_m", nlohmann::json::array()}, {"infeasible_rate", nlohmann::json::array()},
+    nlohmann::json curve{{"generation", nlohmann::json::array()},
+                         {"best_score_m", nlohmann::json::array()},
+                         {"mean_score_m", nlohmann::json::array()},
+                         {"infeasible_rate", nlohmann::json::array()},
                          {"best_so_far_m", nlohmann::json::array()}};
     for (const auto& g : st.curve) {
       curve["generation"].push_back(g.generation);

@@ -118,8 +118,9 @@ void LiveBridge::on_telemetry_sample(const void* sample, std::int64_t received_n
   const std::size_t n = std::min<std::size_t>({cables.size(), t.motor_count(), 4});
   char buf[256];
   // Host times in ms with three decimals: a JS number holds them exactly.
-  std::snprintf(buf, sizeof buf, "{\"e\":%d,\"seq\":%u,\"sample_host_ms\":%.3f,\"received_host_ms\":%.3f,\"mode\":%u,\"fault\":%u",
-                e, t.seq(), t.host_time_ns() == 0 ? -1.0 : static_cast<double>(t.host_time_ns()) / 1e6,
+  std::snprintf(buf, sizeof buf,
+                "{\"e\":%d,\"seq\":%u,\"sample_host_ms\":%.3f,\"received_host_ms\":%.3f,\"mode\":%u,\"fault\":%u", e,
+                t.seq(), t.host_time_ns() == 0 ? -1.0 : static_cast<double>(t.host_time_ns()) / 1e6,
                 static_cast<double>(received_ns) / 1e6, unsigned{t.mode()}, unsigned{t.fault()});
   std::string json = buf;
   const auto list = [&](const char* name, auto&& value) {
@@ -192,18 +193,20 @@ std::string LiveBridge::status_json() const {
     }
     endcaps.push_back(j);
   }
-  return nlohmann::json{{"domain", options_.domain}, {"now_host_ms", static_cast<double>(now) / 1e6},
-                        {"frame_rate_hz", options_.frame_rate_hz}, {"superseded", superseded_},
+  return nlohmann::json{{"domain", options_.domain},
+                        {"now_host_ms", static_cast<double>(now) / 1e6},
+                        {"frame_rate_hz", options_.frame_rate_hz},
+                        {"superseded", superseded_},
                         {"endcaps", endcaps}}
       .dump();
 }
 
 void LiveBridge::status_loop() {
   using clock = std::chrono::steady_clock;
-  const auto frame_period = std::chrono::duration_cast<clock::duration>(
-      std::chrono::duration<double>(1.0 / options_.frame_rate_hz));
-  const auto status_period = std::chrono::duration_cast<clock::duration>(
-      std::chrono::duration<double>(1.0 / options_.status_rate_hz));
+  const auto frame_period =
+      std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / options_.frame_rate_hz));
+  const auto status_period =
+      std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / options_.status_rate_hz));
   auto next_frame = clock::now();
   auto next_status = next_frame;
   std::unique_lock lock(mutex_);

@@ -80,7 +80,7 @@ class LiveBridge {
   mutable std::mutex mutex_;
   std::array<Endcap, kLiveEndcaps> endcaps_{};
   std::array<std::string, kLiveEndcaps> pending_;  // newest sample not yet framed ("" none)
-  std::uint64_t superseded_ = 0;  // samples replaced by a newer one before their frame
+  std::uint64_t superseded_ = 0;                   // samples replaced by a newer one before their frame
   std::unique_ptr<Dds> dds_;
   std::condition_variable stop_cv_;
   bool stopping_ = false;

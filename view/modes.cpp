@@ -43,10 +43,10 @@ LiveView::LiveView(const sim::Robot& robot, int domain, const ServerOptions& ser
   server_.json("/api/robot", [this] { return robot_json_; });
   server_.json("/api/live/status", [this] { return bridge_->status_json(); });
   // The page's clock against the host's, so that it can tell a sample's age.
-  server_.json("/api/clock", [] {
-    return "{\"host_ms\":" + std::to_string(static_cast<double>(LiveBridge::now_ns()) / 1e6) + "}";
-  });
-  server_.events("/api/live/events", hub_, [this] { return "event: status\ndata: " + bridge_->status_json() + "\n\n"; });
+  server_.json("/api/clock",
+               [] { return "{\"host_ms\":" + std::to_string(static_cast<double>(LiveBridge::now_ns()) / 1e6) + "}"; });
+  server_.events("/api/live/events", hub_,
+                 [this] { return "event: status\ndata: " + bridge_->status_json() + "\n\n"; });
   server_.start();
 }
 

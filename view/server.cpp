@@ -83,22 +83,25 @@ void ViewServer::events(const std::string& path, EventHub& hub, std::function<st
     };
     auto stream = std::make_shared<Stream>();
     stream->cursor = hub.head();
-    res.set_chunked_content_provider("text/event-stream", [&hub, hello, stream](std::size_t, httplib::DataSink& sink) {
-      if (!stream->greeted) {
-        stream->greeted = true;
-        hub.reader_joined();
-        // retry: how soon the browser reconnects after the server went away.
-        const std::string first = "retry: 1000\n\n" + hello();
-        return sink.write(first.data(), first.size());
-      }
-      // A comment line when idle: a closed page is noticed within a second.
-      std::string chunk = hub.take(&stream->cursor, 1000, &stream->skipped);
-      if (hub.closed()) return false;
-      if (chunk.empty()) chunk = ": idle\n\n";
-      return sink.write(chunk.data(), chunk.size());
-    }, [&hub, stream](bool) {
-      if (stream->greeted) hub.reader_left();
-    });
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [&hub, hello, stream](std::size_t, httplib::DataSink& sink) {
+          if (!stream->greeted) {
+            stream->greeted = true;
+            hub.reader_joined();
+            // retry: how soon the browser reconnects after the server went away.
+            const std::string first = "retry: 1000\n\n" + hello();
+            return sink.write(first.data(), first.size());
+          }
+          // A comment line when idle: a closed page is noticed within a second.
+          std::string chunk = hub.take(&stream->cursor, 1000, &stream->skipped);
+          if (hub.closed()) return false;
+          if (chunk.empty()) chunk = ": idle\n\n";
+          return sink.write(chunk.data(), chunk.size());
+        },
+        [&hub, stream](bool) {
+          if (stream->greeted) hub.reader_left();
+        });
   });
 }
 

@@ -21,7 +21,8 @@ using json = nlohmann::json;
 // Reads one JSON object, remembering the source and the path for error text.
 class Reader {
  public:
-  Reader(const json& j, std::string source, std::string path) : j_(j), source_(std::move(source)), path_(std::move(path)) {
+  Reader(const json& j, std::string source, std::string path)
+      : j_(j), source_(std::move(source)), path_(std::move(path)) {
     if (!j_.is_object()) fail("", "must be an object");
   }
 
@@ -160,7 +161,8 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
 
   EndcapAppConfig c;
-  if (endcap_id < 0 || endcap_id > 11) throw ConfigError("--id: end cap id must be 0..11, not " + std::to_string(endcap_id));
+  if (endcap_id < 0 || endcap_id > 11)
+    throw ConfigError("--id: end cap id must be 0..11, not " + std::to_string(endcap_id));
   c.endcap_id = endcap_id;
 
   c.bus = top.string("bus");
@@ -172,7 +174,8 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   nodes.only({"drives", "load_cell", "endcap"});
   const json& drives = nodes.at("drives");
   if (!drives.is_array() || drives.empty() || drives.size() > core::kMaxMotorsPerEndcap) {
-    nodes.fail("drives", "must list 1.." + std::to_string(core::kMaxMotorsPerEndcap) + " drive node ids, one per motor");
+    nodes.fail("drives",
+               "must list 1.." + std::to_string(core::kMaxMotorsPerEndcap) + " drive node ids, one per motor");
   }
   c.motor_count = static_cast<std::uint32_t>(drives.size());
   std::set<int> seen;
@@ -247,9 +250,10 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
   json drives = json::array();
   for (std::uint32_t m = 0; m < c.motor_count; ++m) drives.push_back(c.drive_node_ids[m]);
   const core::MotorLimits& l = c.limits;
-  const char* abort_connection = c.drive_abort_connection == canopen::AbortConnectionOption::disable_voltage ? "disable_voltage"
-                                 : c.drive_abort_connection == canopen::AbortConnectionOption::fault_signal   ? "fault"
-                                                                                                            : "quick_stop";
+  const char* abort_connection =
+      c.drive_abort_connection == canopen::AbortConnectionOption::disable_voltage ? "disable_voltage"
+      : c.drive_abort_connection == canopen::AbortConnectionOption::fault_signal  ? "fault"
+                                                                                  : "quick_stop";
   json doc = {
       {"format", "tensegrity-endcap/1"},
       {"bus", c.bus},

@@ -173,8 +173,8 @@ void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns
       master_.request_power(PowerRequest::operation_enabled);
       grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
       // A node that rebooted while lost is pre-operational again: bring it up anew.
-      bool all_operational = master_.heartbeat(NodeRole::load_cell).state == NmtState::operational ||
-                             !settings_.master.use_load_cell;
+      bool all_operational =
+          master_.heartbeat(NodeRole::load_cell).state == NmtState::operational || !settings_.master.use_load_cell;
       for (std::size_t i = 0; i < master_.drive_count(); ++i) {
         all_operational = all_operational && master_.drive_heartbeat(i).state == NmtState::operational;
       }

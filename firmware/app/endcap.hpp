@@ -41,12 +41,12 @@ struct EndcapOptions {
   double duration_s = 0.0;  // 0: until stopped
   bool no_dds = false;
   std::string host_loss = "continue";
-  int domain = -1;  // -1: TENSEGRITY_DOMAIN or the default
-  std::filesystem::path keystore;  // --keystore: overrides the config's dds_keystore
-  bool insecure = false;           // --insecure: DDS without security, explicitly
-  const std::atomic<bool>* link_cut = nullptr;  // --dds-cut-signals
+  int domain = -1;                               // -1: TENSEGRITY_DOMAIN or the default
+  std::filesystem::path keystore;                // --keystore: overrides the config's dds_keystore
+  bool insecure = false;                         // --insecure: DDS without security, explicitly
+  const std::atomic<bool>* link_cut = nullptr;   // --dds-cut-signals
   const std::atomic<bool>* hang_loop = nullptr;  // --hang-loop-signal (HIL tests only)
-  std::filesystem::path stats_path;  // --stats-json: a snapshot every second while running
+  std::filesystem::path stats_path;              // --stats-json: a snapshot every second while running
 };
 
 // The identity `endcap --policy FILE` stores with the file's table: named after

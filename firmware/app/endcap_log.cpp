@@ -34,9 +34,7 @@ void log_event(const AppEvent& e) {
     case AppEventKind::table_rejected:
       log_line("t=%.3f s %s: %s", t_s, to_string(e.kind), core::describe(e.table_error));
       break;
-    case AppEventKind::bring_up_failed:
-      log_line("t=%.3f s bring-up failed: %s (retrying)", t_s, e.text.data());
-      break;
+    case AppEventKind::bring_up_failed: log_line("t=%.3f s bring-up failed: %s (retrying)", t_s, e.text.data()); break;
     case AppEventKind::master_event:
       // SDO results are bring-up chatter; bring-up outcomes are the loop's own events.
       if (e.master_kind == canopen::MasterEventKind::sdo_finished ||

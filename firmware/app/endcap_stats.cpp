@@ -20,11 +20,13 @@ json timing_json(const TimingStats& t) {
 // the wrong type, instead of nlohmann's "type must be number, but is null".
 class Fields {
  public:
-  Fields(const json& j, std::string source, std::string path) : j_(j), source_(std::move(source)), path_(std::move(path)) {
+  Fields(const json& j, std::string source, std::string path)
+      : j_(j), source_(std::move(source)), path_(std::move(path)) {
     if (!j_.is_object()) fail("", "must be an object");
   }
   [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    const std::string field = path_.empty() ? (key.empty() ? "(top level)" : key) : (key.empty() ? path_ : path_ + "." + key);
+    const std::string field =
+        path_.empty() ? (key.empty() ? "(top level)" : key) : (key.empty() ? path_ : path_ + "." + key);
     throw StatsError(source_ + ": " + field + ": " + what);
   }
   template <typename T>
@@ -48,19 +50,29 @@ class Fields {
   // nlohmann converts -1 to a uint64_t and 2.5 to an int without a word.
   template <typename T>
   static bool has_type(const json& v) {
-    if constexpr (std::is_same_v<T, bool>) return v.is_boolean();
-    else if constexpr (std::is_same_v<T, std::string>) return v.is_string();
-    else if constexpr (std::is_unsigned_v<T>) return v.is_number_unsigned();
-    else if constexpr (std::is_integral_v<T>) return v.is_number_integer();
-    else return v.is_number();
+    if constexpr (std::is_same_v<T, bool>)
+      return v.is_boolean();
+    else if constexpr (std::is_same_v<T, std::string>)
+      return v.is_string();
+    else if constexpr (std::is_unsigned_v<T>)
+      return v.is_number_unsigned();
+    else if constexpr (std::is_integral_v<T>)
+      return v.is_number_integer();
+    else
+      return v.is_number();
   }
   template <typename T>
   static const char* expected() {
-    if constexpr (std::is_same_v<T, bool>) return "true or false";
-    else if constexpr (std::is_same_v<T, std::string>) return "a string";
-    else if constexpr (std::is_unsigned_v<T>) return "a count (an integer >= 0)";
-    else if constexpr (std::is_integral_v<T>) return "an integer";
-    else return "a number";
+    if constexpr (std::is_same_v<T, bool>)
+      return "true or false";
+    else if constexpr (std::is_same_v<T, std::string>)
+      return "a string";
+    else if constexpr (std::is_unsigned_v<T>)
+      return "a count (an integer >= 0)";
+    else if constexpr (std::is_integral_v<T>)
+      return "an integer";
+    else
+      return "a number";
   }
   const json& j_;
   std::string source_, path_;

@@ -44,14 +44,14 @@ struct EndcapStats {
   static constexpr const char* kFormat = "tensegrity-endcap-stats/1";
   bool final = false;  // false: a snapshot taken while the program ran
   int endcap = -1;
-  std::string mode;    // "realtime" | "lockstep"
+  std::string mode;  // "realtime" | "lockstep"
   double rate_hz = 0.0;
   std::uint64_t cycles = 0, overruns = 0, stalls = 0, late_wakeups = 0, syncs_received = 0, send_failures = 0,
                 rx_drops = 0, drain_limited_cycles = 0;
   std::string fault = "none";  // core::describe(fault)
   std::string bring_up;        // the drives' bring-up step
   long vm_rss_kb = -1;
-  LinkEvents link;             // the DDS link's events, counted by the node
+  LinkEvents link;  // the DDS link's events, counted by the node
   // At exit only: the loop's timing and, when it was playing, the table's phase.
   std::optional<TimingStats> cycle, wakeup_latency;
   std::optional<TablePhase> table;

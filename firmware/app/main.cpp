@@ -39,11 +39,12 @@ void report_exit(const app::Endcap& endcap, const std::string& stats_path) {
   const app::EndcapStats s = endcap.stats();
   const app::TimingStats cycle = s.cycle.value_or(app::TimingStats{});
   const app::TimingStats wake = s.wakeup_latency.value_or(app::TimingStats{});
-  app::log_line("exit: cycles %llu overruns %llu late wakeups %llu; cycle p50 %.1f us p99 %.1f us max %.1f us; "
-                "wake-up latency p50 %.1f us p99 %.1f us; VmRSS %ld kB",
-                static_cast<unsigned long long>(s.cycles), static_cast<unsigned long long>(s.overruns),
-                static_cast<unsigned long long>(s.late_wakeups), cycle.p50_us, cycle.p99_us, cycle.max_us,
-                wake.p50_us, wake.p99_us, s.vm_rss_kb);
+  app::log_line(
+      "exit: cycles %llu overruns %llu late wakeups %llu; cycle p50 %.1f us p99 %.1f us max %.1f us; "
+      "wake-up latency p50 %.1f us p99 %.1f us; VmRSS %ld kB",
+      static_cast<unsigned long long>(s.cycles), static_cast<unsigned long long>(s.overruns),
+      static_cast<unsigned long long>(s.late_wakeups), cycle.p50_us, cycle.p99_us, cycle.max_us, wake.p50_us,
+      wake.p99_us, s.vm_rss_kb);
   if (!stats_path.empty() && !app::write_stats(stats_path, s)) app::log_line("could not write %s", stats_path.c_str());
 }
 
@@ -78,8 +79,9 @@ int main(int argc, char** argv) {
                                       "its enclave enclaves/tensegrity/endcap_NN");
   cli.add_flag("--insecure", o.insecure, "DDS without security: any participant on the domain may command this end cap")
       ->excludes(keystore_opt);
-  cli.add_flag("--dds-cut-signals", cut_signals,
-               "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
+  cli.add_flag(
+      "--dds-cut-signals", cut_signals,
+      "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
   cli.add_flag("--hang-loop-signal", hang_signal,
                "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
   CLI11_PARSE(cli, argc, argv);

@@ -60,8 +60,9 @@ core::EndcapTable endcap_table_from_policy(const std::string& json_text, int end
     if (!owned.emplace(cable, i).second) fail(source, path + ".cable", "cable listed twice");
   }
   if (owned.size() != motor_count) {
-    fail(source, "cables", "end cap " + std::to_string(endcap_id) + " owns " + std::to_string(owned.size()) +
-                               " cables in this policy, but has " + std::to_string(motor_count) + " motors");
+    fail(source, "cables",
+         "end cap " + std::to_string(endcap_id) + " owns " + std::to_string(owned.size()) +
+             " cables in this policy, but has " + std::to_string(motor_count) + " motors");
   }
   table.motor_count = motor_count;
   std::uint32_t m = 0;

@@ -85,8 +85,8 @@ bool decode_table(const std::vector<std::uint8_t>& bytes, StoredTable& out) {
   if (!v1 && std::memcmp(bytes.data(), kMagic, 4) != 0) return false;
   Cursor c(bytes);
   StoredTable s;
-  if (!c.u64(s.generation) || !c.u32(s.table.motor_count) || !c.u32(s.table.complexity) ||
-      !c.f64(s.table.period_s) || !c.f64(s.table.phase_offset_s)) {
+  if (!c.u64(s.generation) || !c.u32(s.table.motor_count) || !c.u32(s.table.complexity) || !c.f64(s.table.period_s) ||
+      !c.f64(s.table.phase_offset_s)) {
     return false;
   }
   if (s.table.motor_count > core::kMaxMotorsPerEndcap || s.table.complexity > core::kMaxComplexity) return false;

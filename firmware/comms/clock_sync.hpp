@@ -13,7 +13,7 @@
 namespace tensegrity::fw::comms {
 
 struct ClockSample {
-  std::int64_t offset_ns = 0;      // host minus local
+  std::int64_t offset_ns = 0;  // host minus local
   std::int64_t round_trip_ns = 0;
   std::int64_t local_time_ns = 0;  // t4
 };
@@ -32,7 +32,10 @@ class ClockSyncEstimator {
   std::int64_t to_host_ns(std::int64_t local_ns) const { return local_ns + best().offset_ns; }
   std::int64_t to_local_ns(std::int64_t host_ns) const { return host_ns - best().offset_ns; }
   std::size_t samples() const { return count_; }
-  void reset() { count_ = 0; next_ = 0; }
+  void reset() {
+    count_ = 0;
+    next_ = 0;
+  }
 
  private:
   std::array<ClockSample, kWindow> window_{};

@@ -54,8 +54,8 @@ EndcapNode::~EndcapNode() { stop(); }
 void EndcapNode::start() {
   if (running_.load()) return;
   auto d = std::make_unique<Dds>();
-  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), config_.link_cut,
-                                             config_.enclave_dir);
+  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id),
+                                            config_.link_cut, config_.enclave_dir);
   // Reports go out in this end cap's own partition, the only one its identity may
   // write in (msgs/endcap_writers.hpp); orders come in the default one.
   d->publisher = d->participant->create_publisher(msgs::endcap_publisher_qos(config_.endcap_id));

@@ -17,8 +17,8 @@ HostLossAction parse_host_loss_action(const std::string& text) {
 void validate(const EndcapNodeConfig& c) {
   auto positive = [](double v, const char* name, double max) {
     if (!std::isfinite(v) || v <= 0.0 || v > max) {
-      throw std::invalid_argument(std::string(name) + " = " + std::to_string(v) + ": expected > 0 and <= " +
-                                  std::to_string(max));
+      throw std::invalid_argument(std::string(name) + " = " + std::to_string(v) +
+                                  ": expected > 0 and <= " + std::to_string(max));
     }
   };
   if (c.endcap_id < 0 || c.endcap_id > 15) {

@@ -34,7 +34,8 @@ void EndcapNode::report_if_unsynced() {
   log("time sync: not synchronized after %u requests; replies accepted %llu, late or replayed %llu, implausible %llu "
       "(round trip > limit %llu, host hold > limit %llu), conflicting %llu",
       sync_sequence_, static_cast<ull>(c.accepted), static_cast<ull>(c.unknown_nonce), static_cast<ull>(c.implausible),
-      static_cast<ull>(c.implausible_round_trip), static_cast<ull>(c.implausible_hold), static_cast<ull>(c.conflicting));
+      static_cast<ull>(c.implausible_round_trip), static_cast<ull>(c.implausible_hold),
+      static_cast<ull>(c.conflicting));
 }
 
 void EndcapNode::on_time_sync_reply(Dds& d) {
@@ -55,7 +56,8 @@ void EndcapNode::on_time_sync_reply(Dds& d) {
       if (verdict == TimeSyncVerdict::unknown_nonce) unknown = sync_.counters().unknown_nonce;
     }
     // Both say why an end cap stays unsynchronized ("see their logs").
-    if (refused % 100 == 1) log("refused an implausible time-sync reply (%llu so far)", static_cast<unsigned long long>(refused));
+    if (refused % 100 == 1)
+      log("refused an implausible time-sync reply (%llu so far)", static_cast<unsigned long long>(refused));
     if (unknown % 100 == 1) {
       log("ignored a time-sync reply to no open request: late or replayed (%llu so far)",
           static_cast<unsigned long long>(unknown));

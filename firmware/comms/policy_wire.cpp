@@ -140,8 +140,8 @@ PolicyCheck check_policy(const PolicyTableMsg& msg, const PolicyExpectations& ex
                   format("table has %u motors, this end cap has %u", msg.motor_count(), expect.motor_count));
   }
   if (msg.complexity() == 0 || msg.complexity() > core::kMaxComplexity) {
-    return reject(PolicyReason::bad_complexity, format("complexity %u, expected 1..%zu", msg.complexity(),
-                                                       core::kMaxComplexity));
+    return reject(PolicyReason::bad_complexity,
+                  format("complexity %u, expected 1..%zu", msg.complexity(), core::kMaxComplexity));
   }
   if (msg.rest_length_m().size() != static_cast<std::size_t>(msg.motor_count()) * msg.complexity()) {
     return reject(PolicyReason::bad_size, format("%zu rest lengths for %u motors x complexity %u",
@@ -149,8 +149,7 @@ PolicyCheck check_policy(const PolicyTableMsg& msg, const PolicyExpectations& ex
   }
   const std::uint32_t sum = policy_checksum(msg);
   if (sum != msg.checksum()) {
-    return reject(PolicyReason::bad_checksum,
-                  format("checksum 0x%08x, table hashes to 0x%08x", msg.checksum(), sum));
+    return reject(PolicyReason::bad_checksum, format("checksum 0x%08x, table hashes to 0x%08x", msg.checksum(), sum));
   }
   to_endcap_table(msg, c.table);  // sizes checked above
   const core::TableError error = core::validate(c.table, expect.motor_count, expect.limits);

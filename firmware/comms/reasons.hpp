@@ -25,7 +25,7 @@ enum class PolicyReason : std::uint8_t {
   non_finite_value = 11,
   value_out_of_limits = 12,
   stale_version = 13,
-  loop_busy = 14,     // the control loop did not take the table in time
+  loop_busy = 14,  // the control loop did not take the table in time
   bad_policy_id = 15,
   storage_failed = 16,  // the table and its identity could not be made durable: nothing changed
 };

@@ -10,8 +10,8 @@ enum class Plausibility : std::uint8_t { ok, bad_stamp, hold_too_long, round_tri
 
 // Offset and round trip of one exchange, or why it is implausible. Every stamp
 // is range-checked before it is subtracted.
-Plausibility evaluate(const TimeSyncLimits& limits, std::int64_t t1, std::int64_t t2, std::int64_t t3,
-                      std::int64_t t4, ClockSample& out) {
+Plausibility evaluate(const TimeSyncLimits& limits, std::int64_t t1, std::int64_t t2, std::int64_t t3, std::int64_t t4,
+                      ClockSample& out) {
   auto local_ok = [](std::int64_t t) { return t >= -kMaxWireTimeNs && t <= kMaxWireTimeNs; };
   if (!valid_wire_time(t2) || !valid_wire_time(t3) || !local_ok(t1) || !local_ok(t4)) return Plausibility::bad_stamp;
   const std::int64_t hold = t3 - t2;
@@ -111,9 +111,8 @@ void TimeSyncClient::settle_one(Pending& p) {
   if (estimator_.synced() && !agree(estimator_.best(), s, limits_.tolerance_ns)) {
     // A new host, or a liar: only a run of samples that agree with each other
     // replaces the estimate.
-    disagreeing_in_a_row_ = disagreeing_in_a_row_ > 0 && agree(disagreeing_, s, limits_.tolerance_ns)
-                                ? disagreeing_in_a_row_ + 1
-                                : 1;
+    disagreeing_in_a_row_ =
+        disagreeing_in_a_row_ > 0 && agree(disagreeing_, s, limits_.tolerance_ns) ? disagreeing_in_a_row_ + 1 : 1;
     disagreeing_ = s;
     if (disagreeing_in_a_row_ < kResyncAfter) {
       ++counters_.inconsistent;

@@ -90,8 +90,7 @@ void EndcapController::swap_at_boundary(std::int64_t time_ns, StepStatus& status
   status.table_swapped = true;
 }
 
-StepStatus EndcapController::step(std::int64_t time_ns, double dt_s,
-                                  std::span<const double> tension_n,
+StepStatus EndcapController::step(std::int64_t time_ns, double dt_s, std::span<const double> tension_n,
                                   std::span<double> commanded_rest_length_m) noexcept {
   StepStatus status;
   const std::uint32_t n = config_.motor_count;
@@ -111,8 +110,7 @@ StepStatus EndcapController::step(std::int64_t time_ns, double dt_s,
     const std::uint32_t j = clock_.subinterval(t);
     status.subinterval = j;
     for (std::uint32_t m = 0; m < n; ++m) {
-      const std::uint8_t flags =
-          motors_[m].step(active_.rest_length_m[m][j], tension_n[m], dt_s, config_.limits);
+      const std::uint8_t flags = motors_[m].step(active_.rest_length_m[m][j], tension_n[m], dt_s, config_.limits);
       if (flags & kMotorCutOff) status.cutoff_mask |= static_cast<std::uint8_t>(1U << m);
       if (flags & kMotorRateLimited) {
         status.rate_limited_mask |= static_cast<std::uint8_t>(1U << m);

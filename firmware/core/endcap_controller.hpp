@@ -27,9 +27,9 @@ struct StepStatus {
   Mode mode = Mode::idle;
   FaultCause fault = FaultCause::none;
   std::uint32_t subinterval = 0;
-  std::uint8_t cutoff_mask = 0;     // bit m: motor m's shortening was cut off
+  std::uint8_t cutoff_mask = 0;  // bit m: motor m's shortening was cut off
   std::uint8_t rate_limited_mask = 0;
-  bool table_swapped = false;       // a pending table became active this cycle
+  bool table_swapped = false;  // a pending table became active this cycle
 };
 
 class EndcapController {

@@ -5,11 +5,9 @@
 
 namespace tensegrity::core {
 
-std::uint8_t MotorLoop::step(double preferred_m, double tension_n, double dt_s,
-                             const MotorLimits& limits) noexcept {
+std::uint8_t MotorLoop::step(double preferred_m, double tension_n, double dt_s, const MotorLimits& limits) noexcept {
   std::uint8_t flags = 0;
-  const double target =
-      clamp_to(preferred_m, limits.min_rest_length_m, limits.max_rest_length_m);
+  const double target = clamp_to(preferred_m, limits.min_rest_length_m, limits.max_rest_length_m);
   if (target != preferred_m) flags |= kMotorClamped;
 
   const double max_step = dt_s > 0.0 ? limits.speed_m_per_s * dt_s : 0.0;

@@ -21,8 +21,7 @@ class MotorLoop {
   double commanded_m() const noexcept { return commanded_m_; }
 
   // One control cycle of dt_s seconds; returns MotorFlag bits.
-  std::uint8_t step(double preferred_m, double tension_n, double dt_s,
-                    const MotorLimits& limits) noexcept;
+  std::uint8_t step(double preferred_m, double tension_n, double dt_s, const MotorLimits& limits) noexcept;
 
  private:
   double commanded_m_ = 0.0;

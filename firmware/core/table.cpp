@@ -14,9 +14,7 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
 }
 }  // namespace
 
-std::int64_t seconds_to_ns(double seconds) noexcept {
-  return static_cast<std::int64_t>(std::llround(seconds * 1e9));
-}
+std::int64_t seconds_to_ns(double seconds) noexcept { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
 
 const char* describe(TableError error) noexcept {
   switch (error) {
@@ -31,10 +29,8 @@ const char* describe(TableError error) noexcept {
   return "unknown table error";
 }
 
-TableError validate(const EndcapTable& table, std::uint32_t expected_motor_count,
-                    const MotorLimits& limits) noexcept {
-  if (table.motor_count != expected_motor_count || table.motor_count == 0 ||
-      table.motor_count > kMaxMotorsPerEndcap) {
+TableError validate(const EndcapTable& table, std::uint32_t expected_motor_count, const MotorLimits& limits) noexcept {
+  if (table.motor_count != expected_motor_count || table.motor_count == 0 || table.motor_count > kMaxMotorsPerEndcap) {
     return TableError::bad_motor_count;
   }
   if (table.complexity == 0 || table.complexity > kMaxComplexity) return TableError::bad_complexity;
@@ -70,9 +66,7 @@ std::int64_t TableClock::period_index(std::int64_t time_ns) const noexcept {
   return floor_div(time_ns + phase_ns_, period_ns_);
 }
 
-std::int64_t TableClock::period_start_ns(std::int64_t index) const noexcept {
-  return index * period_ns_ - phase_ns_;
-}
+std::int64_t TableClock::period_start_ns(std::int64_t index) const noexcept { return index * period_ns_ - phase_ns_; }
 
 std::uint32_t TableClock::subinterval(std::int64_t time_ns) const noexcept {
   const std::int64_t within = time_ns + phase_ns_ - period_index(time_ns) * period_ns_;

@@ -34,8 +34,7 @@ const char* describe(TableError error) noexcept;
 
 // Checks a table against the end cap's motor count and limits. The longest
 // accepted period is an hour: table time is kept in integer nanoseconds.
-TableError validate(const EndcapTable& table, std::uint32_t expected_motor_count,
-                    const MotorLimits& limits) noexcept;
+TableError validate(const EndcapTable& table, std::uint32_t expected_motor_count, const MotorLimits& limits) noexcept;
 
 // Time arithmetic of a validated table, in integer nanoseconds so that the firmware,
 // the HIL and the simulator pick the same subinterval at the same tick.

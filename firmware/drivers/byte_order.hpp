@@ -21,17 +21,15 @@ inline void put_i24(std::uint8_t* p, std::int32_t v) {
   for (std::size_t i = 0; i < 3; ++i) p[i] = static_cast<std::uint8_t>(u >> (8 * i));
 }
 
-inline std::uint16_t get_u16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
-}
+inline std::uint16_t get_u16(const std::uint8_t* p) { return static_cast<std::uint16_t>(p[0] | (p[1] << 8)); }
 inline std::uint32_t get_u32(const std::uint8_t* p) {
   return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
          static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
 }
 inline std::int32_t get_i32(const std::uint8_t* p) { return static_cast<std::int32_t>(get_u32(p)); }
 inline std::int32_t get_i24(const std::uint8_t* p) {
-  std::uint32_t u = static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
-                    static_cast<std::uint32_t>(p[2]) << 16;
+  std::uint32_t u =
+      static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16;
   if ((u & 0x80'0000U) != 0) u |= 0xFF00'0000U;  // sign-extend
   return static_cast<std::int32_t>(u);
 }

@@ -92,15 +92,13 @@ bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
     case BringUpStep::set_heartbeat_consumer:
       value = consumer_heartbeat_entry(config_.master_node_id, config_.drive_consumer_heartbeat_ms);
       break;
-    case BringUpStep::set_abort_connection:
-      value = static_cast<std::uint16_t>(config_.drive_abort_connection);
-      break;
+    case BringUpStep::set_abort_connection: value = static_cast<std::uint16_t>(config_.drive_abort_connection); break;
     default: break;
   }
   SdoClient& sdo = drives_[b.drive_index].sdo;
   if (!b.request_sent) {
-    b.request_sent =
-        sdo_start(NodeRef{NodeRole::drive, b.drive_index}, spec->upload, spec->address, value, spec->size_bytes, now_ns);
+    b.request_sent = sdo_start(NodeRef{NodeRole::drive, b.drive_index}, spec->upload, spec->address, value,
+                               spec->size_bytes, now_ns);
     return false;
   }
   if (sdo.transfer().status == SdoStatus::pending) return false;
@@ -196,8 +194,7 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
         return;
       }
       break;
-    default:
-      return;
+    default: return;
   }
   if (now_ns - b.step_started_ns > config_.bring_up_step_timeout_ns) {
     request_power(PowerRequest::disabled);

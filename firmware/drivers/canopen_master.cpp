@@ -66,7 +66,8 @@ std::array<CanopenMaster::DriveNode, kMaxDriveNodes> CanopenMaster::make_drives(
 CanopenMaster::CanopenMaster(CanBus& bus, const CanopenMasterConfig& config)
     : bus_(bus),
       config_(config),
-      drive_count_(config.drive_count < 1 ? 1 : (config.drive_count > kMaxDriveNodes ? kMaxDriveNodes : config.drive_count)),
+      drive_count_(
+          config.drive_count < 1 ? 1 : (config.drive_count > kMaxDriveNodes ? kMaxDriveNodes : config.drive_count)),
       drives_(make_drives(config)),
       load_cell_hb_(config.load_cell_heartbeat_timeout_ns),
       load_cell_sdo_(config.load_cell_node_id, config.sdo_timeout_ns) {}
@@ -103,10 +104,8 @@ void CanopenMaster::on_frame(const CanFrame& frame, std::int64_t now_ns) {
     case Function::sync_or_emcy:
     case Function::tpdo1:
     case Function::tpdo2:
-    case Function::sdo_tx:
-      break;
-    default:
-      return drop(RxDrop::unexpected_function);
+    case Function::sdo_tx: break;
+    default: return drop(RxDrop::unexpected_function);
   }
   NodeRef node;
   if (!node_ref(node_of(frame.id), node)) return drop(RxDrop::unknown_node);
@@ -142,9 +141,7 @@ void CanopenMaster::on_heartbeat(const CanFrame& frame, NodeRef node, std::int64
   HeartbeatMonitor& hb = node.role == NodeRole::drive ? drives_[node.drive_index].hb : load_cell_hb_;
   switch (hb.on_heartbeat(state, now_ns)) {
     case HeartbeatMonitor::Change::boot_up: emit(MasterEventKind::boot_up, node_id(node), now_ns); break;
-    case HeartbeatMonitor::Change::restored:
-      emit(MasterEventKind::heartbeat_restored, node_id(node), now_ns);
-      break;
+    case HeartbeatMonitor::Change::restored: emit(MasterEventKind::heartbeat_restored, node_id(node), now_ns); break;
     default: break;
   }
 }
@@ -280,8 +277,7 @@ CanResult CanopenMaster::write_target(std::size_t drive_index, double rest_lengt
   if (!finite) ++targets_refused_;
   const std::uint16_t cw = drives_[drive_index].power.next_controlword(ds.state);
   const bool follow = finite && ds.state == Cia402State::operation_enabled;
-  const std::int32_t target =
-      follow ? config_.spool.counts_from_rest_length(rest_length_m) : ds.position_counts;
+  const std::int32_t target = follow ? config_.spool.counts_from_rest_length(rest_length_m) : ds.position_counts;
   ds.controlword_sent = cw;
   ds.target_sent_counts = target;
   return bus_.send(encode_drive_rpdo1(config_.drive_node(drive_index), {cw, target}));
@@ -298,9 +294,7 @@ CanResult CanopenMaster::send_sync() {
   return r;
 }
 
-CanResult CanopenMaster::send_nmt(NmtCommand command, std::uint8_t id) {
-  return bus_.send(encode_nmt(command, id));
-}
+CanResult CanopenMaster::send_nmt(NmtCommand command, std::uint8_t id) { return bus_.send(encode_nmt(command, id)); }
 
 bool CanopenMaster::sdo_start(NodeRef node, bool upload, SdoAddress address, std::uint32_t value,
                               std::uint8_t size_bytes, std::int64_t now_ns) {

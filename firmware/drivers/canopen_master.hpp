@@ -107,7 +107,7 @@ enum class MasterEventKind : std::uint8_t {
   drive_fault_cleared,  // drive left fault
   sdo_finished,         // done, aborted or timed out: see sdo_transfer()
   bring_up_done,
-  bring_up_failed,      // see bring_up_failure()
+  bring_up_failed,  // see bring_up_failure()
 };
 
 const char* to_string(MasterEventKind kind);
@@ -121,13 +121,13 @@ struct MasterEvent {
 
 enum class BringUpStep : std::uint8_t {
   idle,
-  wait_boot,     // after NMT reset communication: wait for each node's boot-up/heartbeat
-  set_mode,      // SDO 0x6060 = 8 (cyclic synchronous position)
-  check_mode,    // SDO 0x6061 must read 8
+  wait_boot,               // after NMT reset communication: wait for each node's boot-up/heartbeat
+  set_mode,                // SDO 0x6060 = 8 (cyclic synchronous position)
+  check_mode,              // SDO 0x6061 must read 8
   set_heartbeat_consumer,  // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
   set_abort_connection,    // SDO 0x6007 = the abort-connection option (with the consumer only)
-  start_nodes,   // NMT start; wait for heartbeats saying operational
-  enable,        // CiA 402 power-up to operation enabled (needs write_target each cycle)
+  start_nodes,             // NMT start; wait for heartbeats saying operational
+  enable,                  // CiA 402 power-up to operation enabled (needs write_target each cycle)
   done,
   failed,
 };
@@ -217,10 +217,10 @@ class CanopenMaster {
   };
 
   static std::array<DriveNode, kMaxDriveNodes> make_drives(const CanopenMasterConfig& config);
-  SdoClient& sdo_client(NodeRef node) { return node.role == NodeRole::drive ? drives_[node.drive_index].sdo : load_cell_sdo_; }
-  const SdoClient& sdo_client(NodeRole node) const {
-    return node == NodeRole::drive ? drives_[0].sdo : load_cell_sdo_;
+  SdoClient& sdo_client(NodeRef node) {
+    return node.role == NodeRole::drive ? drives_[node.drive_index].sdo : load_cell_sdo_;
   }
+  const SdoClient& sdo_client(NodeRole node) const { return node == NodeRole::drive ? drives_[0].sdo : load_cell_sdo_; }
   SdoClient& sdo_client(NodeRole node) { return sdo_client(NodeRef{node, 0}); }
   bool node_ref(std::uint8_t node_id, NodeRef& node) const;
   std::uint8_t node_id(NodeRef node) const {

@@ -90,7 +90,8 @@ bool decode_controlword(std::uint16_t cw, Cia402Command& command) {
     return true;
   }
   switch (cw & 0x0FU) {
-    case 0x06: case 0x0E: command = Cia402Command::shutdown; return true;
+    case 0x06:
+    case 0x0E: command = Cia402Command::shutdown; return true;
     case 0x07: command = Cia402Command::switch_on; return true;  // or disable operation
     case 0x0F: command = Cia402Command::enable_operation; return true;
     default: return false;

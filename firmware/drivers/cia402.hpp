@@ -22,9 +22,9 @@ inline constexpr std::int8_t kModeCyclicSynchronousPosition = 8;
 inline constexpr std::uint16_t kOdAbortConnectionOption = 0x6007;
 enum class AbortConnectionOption : std::int16_t {
   no_action = 0,
-  fault_signal = 1,      // the drive goes to fault
-  disable_voltage = 2,   // power stage off: the motor coasts (or its brake holds)
-  quick_stop = 3,        // decelerate on the quick-stop ramp, then hold
+  fault_signal = 1,     // the drive goes to fault
+  disable_voltage = 2,  // power stage off: the motor coasts (or its brake holds)
+  quick_stop = 3,       // decelerate on the quick-stop ramp, then hold
 };
 
 enum class Cia402State : std::uint8_t {
@@ -40,13 +40,13 @@ enum class Cia402State : std::uint8_t {
 };
 
 enum class Cia402Command : std::uint8_t {
-  shutdown,          // -> ready to switch on
-  switch_on,         // -> switched on
-  enable_operation,  // -> operation enabled (also from switched on)
-  disable_operation, // operation enabled -> switched on
-  disable_voltage,   // -> switch on disabled
-  quick_stop,        // operation enabled -> quick stop active
-  fault_reset,       // fault -> switch on disabled, on the 0->1 edge of bit 7
+  shutdown,           // -> ready to switch on
+  switch_on,          // -> switched on
+  enable_operation,   // -> operation enabled (also from switched on)
+  disable_operation,  // operation enabled -> switched on
+  disable_voltage,    // -> switch on disabled
+  quick_stop,         // operation enabled -> quick stop active
+  fault_reset,        // fault -> switch on disabled, on the 0->1 edge of bit 7
 };
 
 // Statusword bits beyond the state.
@@ -70,9 +70,9 @@ bool decode_controlword(std::uint16_t controlword, Cia402Command& command);
 
 // What the master asks of the drive.
 enum class PowerRequest : std::uint8_t {
-  disabled,            // voltage off, motor free
-  operation_enabled,   // follow the target position
-  quick_stop,          // stop now, then hold in quick stop
+  disabled,           // voltage off, motor free
+  operation_enabled,  // follow the target position
+  quick_stop,         // stop now, then hold in quick stop
 };
 
 }  // namespace tensegrity::fw::canopen

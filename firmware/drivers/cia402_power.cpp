@@ -21,14 +21,11 @@ std::uint16_t Cia402PowerControl::choose(Cia402State state) {
   switch (state) {
     case S::not_ready_to_switch_on:
     case S::fault_reaction_active:
-    case S::invalid:
-      return controlword_bits(C::disable_voltage);
-    default:
-      break;
+    case S::invalid: return controlword_bits(C::disable_voltage);
+    default: break;
   }
   switch (request_) {
-    case PowerRequest::disabled:
-      return controlword_bits(C::disable_voltage);
+    case PowerRequest::disabled: return controlword_bits(C::disable_voltage);
     case PowerRequest::quick_stop:
       return state == S::operation_enabled || state == S::quick_stop_active ? controlword_bits(C::quick_stop)
                                                                             : controlword_bits(C::disable_voltage);

@@ -34,8 +34,6 @@ constexpr std::uint16_t cob_id(Function f, std::uint8_t node_id) {
 }
 constexpr Function function_of(std::uint32_t cob) { return static_cast<Function>(cob & 0x780U); }
 constexpr std::uint8_t node_of(std::uint32_t cob) { return static_cast<std::uint8_t>(cob & 0x7FU); }
-constexpr bool is_valid_node_id(std::uint8_t node_id) {
-  return node_id >= kNodeIdMin && node_id <= kNodeIdMax;
-}
+constexpr bool is_valid_node_id(std::uint8_t node_id) { return node_id >= kNodeIdMin && node_id <= kNodeIdMax; }
 
 }  // namespace tensegrity::fw::canopen

@@ -41,12 +41,15 @@ bool decode_nmt(const CanFrame& frame, NmtCommand& command, std::uint8_t& node_i
     return false;
   }
   switch (frame.data[0]) {
-    case 0x01: case 0x02: case 0x80: case 0x81: case 0x82:
+    case 0x01:
+    case 0x02:
+    case 0x80:
+    case 0x81:
+    case 0x82:
       command = static_cast<NmtCommand>(frame.data[0]);
       node_id = frame.data[1];
       return true;
-    default:
-      return false;
+    default: return false;
   }
 }
 
@@ -60,11 +63,11 @@ CanFrame encode_heartbeat(std::uint8_t node_id, NmtState state) {
 
 bool decode_nmt_state(std::uint8_t byte, NmtState& state) {
   switch (byte) {
-    case 0x00: case 0x04: case 0x05: case 0x7F:
-      state = static_cast<NmtState>(byte);
-      return true;
-    default:
-      return false;
+    case 0x00:
+    case 0x04:
+    case 0x05:
+    case 0x7F: state = static_cast<NmtState>(byte); return true;
+    default: return false;
   }
 }
 

@@ -16,9 +16,7 @@ CanFrame make(Function f, std::uint8_t node_id, std::uint8_t dlc) {
   return frame;
 }
 
-bool plain(const CanFrame& frame, std::uint8_t dlc) {
-  return !frame.extended && !frame.rtr && frame.dlc == dlc;
-}
+bool plain(const CanFrame& frame, std::uint8_t dlc) { return !frame.extended && !frame.rtr && frame.dlc == dlc; }
 
 }  // namespace
 

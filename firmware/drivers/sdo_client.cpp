@@ -28,8 +28,8 @@ bool SdoClient::start_upload(SdoAddress address, std::int64_t now_ns, CanFrame& 
   return true;
 }
 
-bool SdoClient::start_download(SdoAddress address, std::uint32_t value, std::uint8_t size_bytes,
-                               std::int64_t now_ns, CanFrame& request) {
+bool SdoClient::start_download(SdoAddress address, std::uint32_t value, std::uint8_t size_bytes, std::int64_t now_ns,
+                               CanFrame& request) {
   if (busy() || size_bytes < 1 || size_bytes > 4) return false;
   transfer_ = SdoTransfer{};
   transfer_.status = SdoStatus::pending;
@@ -54,9 +54,7 @@ SdoRx SdoClient::on_response(const CanFrame& frame, std::int64_t now_ns, CanFram
   if (!decode_sdo(frame, true, m)) return SdoRx::malformed;
   if (!busy() || m.address != transfer_.address) return SdoRx::unexpected;
   switch (m.kind) {
-    case SdoKind::abort:
-      finish_with_abort(m.value, true, now_ns);
-      return SdoRx::completed;
+    case SdoKind::abort: finish_with_abort(m.value, true, now_ns); return SdoRx::completed;
     case SdoKind::upload_response:
       if (!transfer_.upload) break;
       transfer_.status = SdoStatus::done;
@@ -69,8 +67,7 @@ SdoRx SdoClient::on_response(const CanFrame& frame, std::int64_t now_ns, CanFram
       transfer_.status = SdoStatus::done;
       transfer_.finished_ns = now_ns;
       return SdoRx::completed;
-    default:
-      break;
+    default: break;
   }
   // A segmented upload start, or a response that does not fit the request: the
   // server now waits on us, so end the transfer on its side too.

@@ -30,8 +30,7 @@ bool parse_udp_endpoint(std::string_view text, UdpEndpoint& out, std::string& er
   }
   unsigned port = 0;
   const auto [end, ec] = std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
-  if (port_text.empty() || ec != std::errc() || end != port_text.data() + port_text.size() ||
-      port > 65535) {
+  if (port_text.empty() || ec != std::errc() || end != port_text.data() + port_text.size() || port > 65535) {
     error = "port must be a number 0..65535, got " + quoted(port_text);
     return false;
   }
@@ -44,8 +43,7 @@ bool parse_can_bus_spec(std::string_view spec, CanBusSpec& out, std::string& err
   CanBusSpec result;
   if (spec.starts_with(kSocketCanPrefix)) {
     const std::string_view name = spec.substr(kSocketCanPrefix.size());
-    if (name.empty() || name.size() > kIfNameMax ||
-        name.find_first_of("/:, \t") != std::string_view::npos) {
+    if (name.empty() || name.size() > kIfNameMax || name.find_first_of("/:, \t") != std::string_view::npos) {
       error = "socketcan: interface name must be 1.." + std::to_string(kIfNameMax) +
               " characters without '/', ':', ',' or spaces, got " + quoted(name);
       return false;
@@ -96,8 +94,7 @@ bool parse_can_bus_spec(std::string_view spec, CanBusSpec& out, std::string& err
     out = std::move(result);
     return true;
   }
-  error = "unknown CAN bus " + quoted(spec) +
-          "; expected udp:HOST:PORT[,bind=HOST:PORT][,batch] or socketcan:IFNAME";
+  error = "unknown CAN bus " + quoted(spec) + "; expected udp:HOST:PORT[,bind=HOST:PORT][,batch] or socketcan:IFNAME";
   return false;
 }
 

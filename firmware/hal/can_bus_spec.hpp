@@ -21,10 +21,10 @@ struct UdpEndpoint {
 struct CanBusSpec {
   enum class Kind : std::uint8_t { udp, socketcan };
   Kind kind = Kind::udp;
-  UdpEndpoint remote;         // udp
-  UdpEndpoint bind;           // udp
-  bool batch = false;         // udp: send version 2 (the peer must read it)
-  std::string interface_name; // socketcan
+  UdpEndpoint remote;          // udp
+  UdpEndpoint bind;            // udp
+  bool batch = false;          // udp: send version 2 (the peer must read it)
+  std::string interface_name;  // socketcan
 };
 
 // "HOST:PORT"; port 0..65535, host non-empty.

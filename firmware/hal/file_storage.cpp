@@ -81,8 +81,8 @@ const char* to_string(StorageResult result) {
 bool is_valid_blob_name(std::string_view name) {
   if (name.empty() || name.size() > 64 || name.front() == '.') return false;
   for (const char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '-' || c == '.';
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
     if (!ok) return false;
   }
   return true;
@@ -90,9 +90,7 @@ bool is_valid_blob_name(std::string_view name) {
 
 FileStorage::FileStorage(std::filesystem::path directory) : directory_(std::move(directory)) {}
 
-std::filesystem::path FileStorage::blob_path(std::string_view name) const {
-  return directory_ / std::string(name);
-}
+std::filesystem::path FileStorage::blob_path(std::string_view name) const { return directory_ / std::string(name); }
 
 std::filesystem::path FileStorage::temp_path(std::string_view name) const {
   return directory_ / ("." + std::string(name) + ".tmp");

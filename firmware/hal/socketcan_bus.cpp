@@ -26,16 +26,15 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface_na
   if (fd < 0) {
     const int e = errno;
     error = e == EAFNOSUPPORT
-                ? std::string("socketcan: kernel has no CAN support (socket(AF_CAN) failed: ") +
-                      std::strerror(e) + ")"
+                ? std::string("socketcan: kernel has no CAN support (socket(AF_CAN) failed: ") + std::strerror(e) + ")"
                 : std::string("socketcan: socket(AF_CAN) failed: ") + std::strerror(e);
     return nullptr;
   }
   const unsigned index = ::if_nametoindex(interface_name.c_str());
   if (index == 0) {
     error = "socketcan: no interface '" + interface_name + "' (" + std::strerror(errno) +
-            "); for a virtual bus: ip link add dev " + interface_name + " type vcan && ip link set " +
-            interface_name + " up";
+            "); for a virtual bus: ip link add dev " + interface_name + " type vcan && ip link set " + interface_name +
+            " up";
     ::close(fd);
     return nullptr;
   }
@@ -56,8 +55,7 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface_na
   return std::unique_ptr<SocketCanBus>(new SocketCanBus(fd, interface_name));
 }
 
-SocketCanBus::SocketCanBus(int fd, std::string interface_name)
-    : fd_(fd), interface_name_(std::move(interface_name)) {}
+SocketCanBus::SocketCanBus(int fd, std::string interface_name) : fd_(fd), interface_name_(std::move(interface_name)) {}
 
 SocketCanBus::~SocketCanBus() { ::close(fd_); }
 
@@ -72,8 +70,8 @@ CanResult SocketCanBus::set_filters(std::span<const CanIdFilter> filters) {
     kernel_filters.push_back(k);
   }
   const auto bytes = static_cast<socklen_t>(kernel_filters.size() * sizeof(can_filter));
-  if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, kernel_filters.empty() ? nullptr : kernel_filters.data(),
-                   bytes) != 0) {
+  if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, kernel_filters.empty() ? nullptr : kernel_filters.data(), bytes) !=
+      0) {
     last_errno_ = errno;
     return CanResult::io_error;
   }

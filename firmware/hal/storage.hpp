@@ -19,7 +19,7 @@ enum class StorageResult : std::uint8_t {
   not_found,
   invalid_name,  // names are [A-Za-z0-9_.-], 1..64 chars, not starting with '.'
   too_large,
-  corrupt,       // header, length or CRC does not match: the blob is not trusted
+  corrupt,  // header, length or CRC does not match: the blob is not trusted
   io_error,
 };
 

@@ -50,7 +50,9 @@ class BatchWriter {
   bool empty() const { return count_ == 0; }
   bool full() const { return count_ == kMaxBatchFrames; }
   // The datagram to send: header and count() records.
-  std::span<const std::uint8_t> bytes() const { return {bytes_.data(), kBatchHeaderBytes + count_ * kBatchRecordBytes}; }
+  std::span<const std::uint8_t> bytes() const {
+    return {bytes_.data(), kBatchHeaderBytes + count_ * kBatchRecordBytes};
+  }
   void clear();
 
  private:

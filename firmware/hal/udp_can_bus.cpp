@@ -48,8 +48,8 @@ std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::stri
     return nullptr;
   }
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&local), sizeof(local)) != 0) {
-    error = "udp: cannot bind " + config.bind.host + ":" + std::to_string(config.bind.port) +
-            ": " + std::strerror(errno);
+    error =
+        "udp: cannot bind " + config.bind.host + ":" + std::to_string(config.bind.port) + ": " + std::strerror(errno);
     ::close(fd);
     return nullptr;
   }
@@ -60,8 +60,7 @@ std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::stri
   return bus;
 }
 
-UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port, bool batch)
-    : fd_(fd), local_port_(local_port), batch_(batch) {}
+UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port, bool batch) : fd_(fd), local_port_(local_port), batch_(batch) {}
 
 UdpCanBus::~UdpCanBus() { ::close(fd_); }
 
@@ -113,8 +112,8 @@ CanResult UdpCanBus::send_bytes(std::span<const std::uint8_t> bytes, std::size_t
   to.sin_addr.s_addr = remote_addr_be_;
   to.sin_port = remote_port_be_;
   for (;;) {
-    const ssize_t n = ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT,
-                               reinterpret_cast<const sockaddr*>(&to), sizeof(to));
+    const ssize_t n =
+        ::sendto(fd_, bytes.data(), bytes.size(), MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(&to), sizeof(to));
     if (n == static_cast<ssize_t>(bytes.size())) {
       counters_.tx_frames += frames;
       return CanResult::ok;
@@ -145,9 +144,7 @@ void UdpCanBus::take_datagram(std::span<const std::uint8_t> datagram) {
         ++counters_.rx_frames;
         rx_queue_[rx_count_++] = got;
         break;
-      case udp_can::Decoded::error_report:
-        can_error::apply_error_report(counters_, got.id);
-        break;
+      case udp_can::Decoded::error_report: can_error::apply_error_report(counters_, got.id); break;
       default:
         ++counters_.rx_malformed;
         ++drops_[static_cast<std::size_t>(decoded)];

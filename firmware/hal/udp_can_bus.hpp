@@ -44,9 +44,7 @@ class UdpCanBus final : public CanBus {
   bool set_remote(const UdpEndpoint& remote, std::string& error);
   std::uint16_t local_port() const { return local_port_; }
   // Datagrams dropped for `reason` (frame and error_report count as received).
-  std::uint64_t dropped(udp_can::Decoded reason) const {
-    return drops_[static_cast<std::size_t>(reason)];
-  }
+  std::uint64_t dropped(udp_can::Decoded reason) const { return drops_[static_cast<std::size_t>(reason)]; }
   int last_errno() const { return last_errno_; }
 
  private:

@@ -6,8 +6,7 @@ namespace {
 
 constexpr std::array<std::uint8_t, 4> kMagic = {'T', 'C', 'A', 'N'};
 
-Datagram encode_raw(std::uint8_t flags, std::uint8_t dlc, std::uint32_t id,
-                    const std::array<std::uint8_t, 8>& data) {
+Datagram encode_raw(std::uint8_t flags, std::uint8_t dlc, std::uint32_t id, const std::array<std::uint8_t, 8>& data) {
   Datagram d{};
   for (std::size_t i = 0; i < kMagic.size(); ++i) d[i] = kMagic[i];
   d[4] = kVersion;

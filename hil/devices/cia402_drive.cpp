@@ -15,11 +15,8 @@ std::uint16_t SimCia402Drive::statusword() const {
     case Cia402State::ready_to_switch_on:
     case Cia402State::switched_on:
     case Cia402State::operation_enabled:
-    case Cia402State::quick_stop_active:
-      sw |= kSwVoltageEnabled;
-      break;
-    default:
-      break;
+    case Cia402State::quick_stop_active: sw |= kSwVoltageEnabled; break;
+    default: break;
   }
   return sw;
 }
@@ -156,8 +153,7 @@ void SimCia402Drive::apply_controlword_to_state(std::uint16_t cw) {
       if (c == C::disable_voltage) state_ = S::switch_on_disabled;
       if (c == C::enable_operation) state_ = S::operation_enabled;
       break;
-    default:
-      break;
+    default: break;
   }
 }
 
@@ -175,8 +171,8 @@ void SimCia402Drive::on_pdo_or_sync(const CanFrame& frame, std::int64_t now_ns, 
   if (ideal_position) {
     // CSP: the target latched at SYNC is reached within the cycle (an ideal drive).
     if (state_ == Cia402State::operation_enabled && mode_ == kModeCyclicSynchronousPosition) {
-      velocity_counts_per_s_ = static_cast<std::int32_t>(static_cast<double>(target_counts_ - position_counts_) /
-                                                         sync_period_s);
+      velocity_counts_per_s_ =
+          static_cast<std::int32_t>(static_cast<double>(target_counts_ - position_counts_) / sync_period_s);
       position_counts_ = target_counts_;
     } else {
       velocity_counts_per_s_ = 0;
@@ -196,14 +192,35 @@ std::uint32_t SimCia402Drive::od_read(SdoAddress a, std::uint32_t& value, std::u
   if (!maybe_known) return sdo_abort::kNoObject;
   if (a.subindex != 0) return sdo_abort::kNoSubindex;
   switch (a.index) {
-    case 0x1000: value = 0x0002'0192; size = 4; return 0;  // CiA 402 servo drive
-    case kOdControlword: value = last_controlword_; size = 2; return 0;
-    case kOdStatusword: value = statusword(); size = 2; return 0;
+    case 0x1000:
+      value = 0x0002'0192;
+      size = 4;
+      return 0;  // CiA 402 servo drive
+    case kOdControlword:
+      value = last_controlword_;
+      size = 2;
+      return 0;
+    case kOdStatusword:
+      value = statusword();
+      size = 2;
+      return 0;
     case kOdModesOfOperation:
-    case kOdModesOfOperationDisplay: value = static_cast<std::uint8_t>(mode_); size = 1; return 0;
-    case kOdPositionActual: value = static_cast<std::uint32_t>(position_counts_); size = 4; return 0;
-    case kOdVelocityActual: value = static_cast<std::uint32_t>(velocity_counts_per_s_); size = 4; return 0;
-    case kOdTargetPosition: value = static_cast<std::uint32_t>(target_counts_); size = 4; return 0;
+    case kOdModesOfOperationDisplay:
+      value = static_cast<std::uint8_t>(mode_);
+      size = 1;
+      return 0;
+    case kOdPositionActual:
+      value = static_cast<std::uint32_t>(position_counts_);
+      size = 4;
+      return 0;
+    case kOdVelocityActual:
+      value = static_cast<std::uint32_t>(velocity_counts_per_s_);
+      size = 4;
+      return 0;
+    case kOdTargetPosition:
+      value = static_cast<std::uint32_t>(target_counts_);
+      size = 4;
+      return 0;
     default: return sdo_abort::kNoObject;
   }
 }
@@ -234,10 +251,8 @@ std::uint32_t SimCia402Drive::od_write(SdoAddress a, std::uint32_t value, std::u
     case kOdStatusword:
     case kOdModesOfOperationDisplay:
     case kOdPositionActual:
-    case kOdVelocityActual:
-      return sdo_abort::kReadOnly;
-    default:
-      return sdo_abort::kNoObject;
+    case kOdVelocityActual: return sdo_abort::kReadOnly;
+    default: return sdo_abort::kNoObject;
   }
 }
 

@@ -26,9 +26,9 @@ class SimNode {
   struct Script {
     bool heartbeat = true;
     std::int64_t heartbeat_period_ns = 20'000'000;
-    bool sdo_silent = false;             // never answer SDO requests
-    std::uint32_t sdo_abort_all = 0;     // answer every SDO request with this abort
-    bool sdo_segmented_upload = false;   // answer uploads with a segmented-transfer start
+    bool sdo_silent = false;            // never answer SDO requests
+    std::uint32_t sdo_abort_all = 0;    // answer every SDO request with this abort
+    bool sdo_segmented_upload = false;  // answer uploads with a segmented-transfer start
     // Stop answering altogether: no heartbeat, no PDOs, no SDO, frames ignored
     // (a device that lost power or its CAN transceiver).
     bool silent = false;

@@ -48,7 +48,7 @@ struct Analysis {
   FaceCycle cycle;
   std::vector<double> touchdown_intervals_s;
   double touchdown_interval_s = 0.0;  // median of the intervals; 0 without any
-  ContactPeriod contact_period;        // the revolution, from every end cap's contacts
+  ContactPeriod contact_period;       // the revolution, from every end cap's contacts
   Turning turning;
   double rotation_period_s = 0.0;  // window length / revolutions; 0 below one revolution
   SlipSummary slip;

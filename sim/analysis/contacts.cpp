@@ -10,9 +10,8 @@ namespace tensegrity::sim::analysis {
 namespace {
 
 // Raw runs of contact of one end cap, joined across gaps shorter than `debounce_s`.
-std::vector<ContactInterval> spans_of(const std::vector<double>& time_s,
-                                      const std::vector<std::vector<bool>>& touching, std::size_t node,
-                                      double debounce_s) {
+std::vector<ContactInterval> spans_of(const std::vector<double>& time_s, const std::vector<std::vector<bool>>& touching,
+                                      std::size_t node, double debounce_s) {
   std::vector<ContactInterval> out;
   bool in = false;
   for (std::size_t k = 0; k < time_s.size(); ++k) {
@@ -47,7 +46,8 @@ int Contacts::touched_count() const {
 
 Contacts detect_contacts(const std::vector<double>& time_s, const std::vector<std::vector<Eigen::Vector3d>>& node_m,
                          double endcap_radius_m, const ContactOptions& options) {
-  if (time_s.size() != node_m.size()) throw std::invalid_argument("detect_contacts: times and positions differ in count");
+  if (time_s.size() != node_m.size())
+    throw std::invalid_argument("detect_contacts: times and positions differ in count");
   Contacts c;
   const std::size_t nodes = node_m.empty() ? 0 : node_m.front().size();
   c.share.assign(nodes, 0.0);

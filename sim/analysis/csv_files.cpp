@@ -114,8 +114,8 @@ void faces(std::ostream& out, const Analysis& a) {
   out << "index,start_s,end_s,endcap_a,endcap_b,endcap_c,closed\n";
   for (std::size_t i = 0; i < a.faces.size(); ++i) {
     const auto& f = a.faces[i];
-    out << i << ',' << f.start_s << ',' << f.end_s << ',' << f.nodes[0] << ',' << f.nodes[1] << ',' << f.nodes[2]
-        << ',' << (f.closed ? 1 : 0) << '\n';
+    out << i << ',' << f.start_s << ',' << f.end_s << ',' << f.nodes[0] << ',' << f.nodes[1] << ',' << f.nodes[2] << ','
+        << (f.closed ? 1 : 0) << '\n';
   }
 }
 
@@ -131,22 +131,33 @@ void endcaps(std::ostream& out, const Analysis& a) {
 
 }  // namespace
 
-std::vector<std::string> write_csv_files(const std::filesystem::path& dir, const EpisodeSeries& s,
-                                         const Analysis& a) {
+std::vector<std::string> write_csv_files(const std::filesystem::path& dir, const EpisodeSeries& s, const Analysis& a) {
   std::filesystem::create_directories(dir);
   std::vector<std::string> w;
-  write_file(dir, "fig10_11_muscles.csv", [&](std::ostream& o) { muscles(o, a); }, w);
-  write_file(dir, "fig11_timeseries.csv", [&](std::ostream& o) { timeseries(o, s, a); }, w);
-  write_file(dir, "fig12_signals.csv", [&](std::ostream& o) { signals(o, s); }, w);
-  write_file(dir, "fig12_correlation.csv", [&](std::ostream& o) { matrix(o, a.correlation); }, w);
-  write_file(dir, "fig12_linkage.csv", [&](std::ostream& o) { linkage(o, a.tree); }, w);
-  write_file(dir, "fig12_aligned_correlation.csv", [&](std::ostream& o) { matrix(o, a.aligned.r); }, w);
-  write_file(dir, "fig12_aligned_lag_samples.csv", [&](std::ostream& o) { lags(o, a.aligned.lag); }, w);
-  write_file(dir, "fig12_aligned_linkage.csv", [&](std::ostream& o) { linkage(o, a.aligned_tree); }, w);
-  write_file(dir, "fig12_clusters.csv", [&](std::ostream& o) { clusters(o, a); }, w);
-  write_file(dir, "contacts.csv", [&](std::ostream& o) { contacts(o, s, a); }, w);
-  write_file(dir, "faces.csv", [&](std::ostream& o) { faces(o, a); }, w);
-  write_file(dir, "endcaps.csv", [&](std::ostream& o) { endcaps(o, a); }, w);
+  write_file(
+      dir, "fig10_11_muscles.csv", [&](std::ostream& o) { muscles(o, a); }, w);
+  write_file(
+      dir, "fig11_timeseries.csv", [&](std::ostream& o) { timeseries(o, s, a); }, w);
+  write_file(
+      dir, "fig12_signals.csv", [&](std::ostream& o) { signals(o, s); }, w);
+  write_file(
+      dir, "fig12_correlation.csv", [&](std::ostream& o) { matrix(o, a.correlation); }, w);
+  write_file(
+      dir, "fig12_linkage.csv", [&](std::ostream& o) { linkage(o, a.tree); }, w);
+  write_file(
+      dir, "fig12_aligned_correlation.csv", [&](std::ostream& o) { matrix(o, a.aligned.r); }, w);
+  write_file(
+      dir, "fig12_aligned_lag_samples.csv", [&](std::ostream& o) { lags(o, a.aligned.lag); }, w);
+  write_file(
+      dir, "fig12_aligned_linkage.csv", [&](std::ostream& o) { linkage(o, a.aligned_tree); }, w);
+  write_file(
+      dir, "fig12_clusters.csv", [&](std::ostream& o) { clusters(o, a); }, w);
+  write_file(
+      dir, "contacts.csv", [&](std::ostream& o) { contacts(o, s, a); }, w);
+  write_file(
+      dir, "faces.csv", [&](std::ostream& o) { faces(o, a); }, w);
+  write_file(
+      dir, "endcaps.csv", [&](std::ostream& o) { endcaps(o, a); }, w);
   return w;
 }
 

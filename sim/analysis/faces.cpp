@@ -7,9 +7,8 @@ namespace tensegrity::sim::analysis {
 namespace {
 
 bool is_cable(const std::vector<std::pair<int, int>>& cables, int a, int b) {
-  return std::any_of(cables.begin(), cables.end(), [&](const auto& c) {
-    return (c.first == a && c.second == b) || (c.first == b && c.second == a);
-  });
+  return std::any_of(cables.begin(), cables.end(),
+                     [&](const auto& c) { return (c.first == a && c.second == b) || (c.first == b && c.second == a); });
 }
 
 // The three touching end caps of a sample, or {-1,-1,-1} unless exactly three touch.
@@ -38,8 +37,8 @@ std::vector<GroundFace> face_sequence(const std::vector<double>& time_s, const C
       return;
     }
     const auto& v = run.nodes;
-    run.closed = is_cable(cable_nodes, v[0], v[1]) && is_cable(cable_nodes, v[1], v[2]) &&
-                 is_cable(cable_nodes, v[0], v[2]);
+    run.closed =
+        is_cable(cable_nodes, v[0], v[1]) && is_cable(cable_nodes, v[1], v[2]) && is_cable(cable_nodes, v[0], v[2]);
     out.push_back(run);
   };
   for (std::size_t k = 0; k < time_s.size(); ++k) {

@@ -11,9 +11,9 @@ namespace tensegrity::sim::analysis {
 struct MuscleStats {
   int cable = 0;
   double rest_min_m = 0.0, rest_max_m = 0.0, rest_mean_m = 0.0;  // Figure 10
-  double length_mean_m = 0.0;                                      // Figure 11a
-  double tension_mean_n = 0.0, tension_max_n = 0.0;                // Figure 11b
-  double power_mean_w = 0.0;                                       // Figure 11e
+  double length_mean_m = 0.0;                                    // Figure 11a
+  double tension_mean_n = 0.0, tension_max_n = 0.0;              // Figure 11b
+  double power_mean_w = 0.0;                                     // Figure 11e
 };
 
 // Each cable over samples [first, end).

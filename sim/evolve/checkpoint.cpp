@@ -14,8 +14,8 @@ namespace {
 constexpr const char* kFormat = "tensegrity-evolve-checkpoint/1";
 
 nlohmann::json stats_to_json(const GenerationStats& s) {
-  return {{"generation", s.generation},     {"episodes", s.episodes},         {"teams", s.teams},
-          {"infeasible", s.infeasible},     {"best_score_m", s.best_score_m}, {"mean_score_m", s.mean_score_m},
+  return {{"generation", s.generation},      {"episodes", s.episodes},         {"teams", s.teams},
+          {"infeasible", s.infeasible},      {"best_score_m", s.best_score_m}, {"mean_score_m", s.mean_score_m},
           {"best_so_far_m", s.best_so_far_m}};
 }
 
@@ -80,8 +80,8 @@ Checkpoint parse_checkpoint(const std::string& text, const std::string& source) 
     for (const auto& population : j.at("populations")) {
       auto& members = s.populations.emplace_back();
       for (const auto& m : population) {
-        members.push_back(Member{m.at("rest_lengths_m").get<std::vector<double>>(),
-                                 m.at("history").get<std::vector<double>>()});
+        members.push_back(
+            Member{m.at("rest_lengths_m").get<std::vector<double>>(), m.at("history").get<std::vector<double>>()});
       }
     }
     for (const auto& g : j.at("curve")) s.curve.push_back(stats_from_json(g));
@@ -123,7 +123,8 @@ void save_checkpoint(const std::filesystem::path& dir, const EvolveConfig& confi
 
 bool checkpoint_exists(const std::filesystem::path& dir) {
   std::error_code ec;
-  return std::filesystem::exists(dir / kCheckpointFile, ec) || std::filesystem::exists(dir / kPreviousCheckpointFile, ec);
+  return std::filesystem::exists(dir / kCheckpointFile, ec) ||
+         std::filesystem::exists(dir / kPreviousCheckpointFile, ec);
 }
 
 namespace {

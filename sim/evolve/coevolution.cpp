@@ -30,7 +30,8 @@ void check_state(const EvolveConfig& c, const CoevolutionState& s) {
     for (const auto& member : population) {
       if (static_cast<int>(member.rest_lengths_m.size()) != c.complexity) fail("member length differs from complexity");
       for (double v : member.rest_lengths_m) {
-        if (!(v >= c.min_rest_length_m && v <= c.max_rest_length_m)) fail("member value outside the rest-length limits");
+        if (!(v >= c.min_rest_length_m && v <= c.max_rest_length_m))
+          fail("member value outside the rest-length limits");
       }
       for (double h : member.history) {
         if (!std::isfinite(h)) fail("non-finite score in a history");

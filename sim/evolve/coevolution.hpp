@@ -22,13 +22,13 @@ struct Member {
 };
 
 struct GenerationStats {
-  int generation = 0;           // 1 for the first generation
-  std::int64_t episodes = 0;    // total so far, this generation included
-  int teams = 0;                // evaluated this generation
-  int infeasible = 0;           // of those, infeasible (scored 0)
-  double best_score_m = 0.0;    // best team this generation
-  double mean_score_m = 0.0;    // mean team score this generation
-  double best_so_far_m = 0.0;   // best team of the run so far
+  int generation = 0;          // 1 for the first generation
+  std::int64_t episodes = 0;   // total so far, this generation included
+  int teams = 0;               // evaluated this generation
+  int infeasible = 0;          // of those, infeasible (scored 0)
+  double best_score_m = 0.0;   // best team this generation
+  double mean_score_m = 0.0;   // mean team score this generation
+  double best_so_far_m = 0.0;  // best team of the run so far
   double infeasible_rate() const { return teams > 0 ? static_cast<double>(infeasible) / teams : 0.0; }
 };
 

@@ -30,8 +30,8 @@ struct DriverOptions {
 struct DriverResult {
   Coevolution evolution;
   bool resumed = false;
-  int resumed_generation = 0;            // generations already done when resumed
-  std::int64_t resumed_episodes = 0;     // episodes already done when resumed
+  int resumed_generation = 0;         // generations already done when resumed
+  std::int64_t resumed_episodes = 0;  // episodes already done when resumed
   std::vector<std::string> warnings;  // e.g. a corrupt checkpoint skipped
 };
 

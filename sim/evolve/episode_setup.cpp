@@ -17,8 +17,8 @@ Robot parse_checked(const EpisodeSetup& setup) {
 }  // namespace
 
 EpisodeSetup episode_setup(const std::string& robot_json, const EvolveConfig& config) {
-  EpisodeSetup setup{robot_json, config.robot_hash, config.cables, config.period_s, config.complexity,
-                     config.duration_s};
+  EpisodeSetup setup{robot_json,      config.robot_hash, config.cables,
+                     config.period_s, config.complexity, config.duration_s};
   // Fail on rank 0, before anything is sent, when the text is not the config's robot.
   (void)parse_checked(setup);
   return setup;

@@ -32,8 +32,8 @@ struct MpiEvaluatorOptions {
 struct RankLoad {
   int rank = 0;
   std::string host;
-  int threads = 0;          // teams it evaluates at once
-  std::int64_t teams = 0;   // teams it has evaluated so far
+  int threads = 0;         // teams it evaluates at once
+  std::int64_t teams = 0;  // teams it has evaluated so far
   std::string build;
 };
 

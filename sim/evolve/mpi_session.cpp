@@ -25,7 +25,9 @@ void check(int code, const char* what) {
   if (code != MPI_SUCCESS) throw MpiFailure(std::string(what) + ": " + error_text(code));
 }
 
-bool known_tag(int tag) { return tag >= static_cast<int>(wire::Tag::setup) && tag <= static_cast<int>(wire::Tag::stop); }
+bool known_tag(int tag) {
+  return tag >= static_cast<int>(wire::Tag::setup) && tag <= static_cast<int>(wire::Tag::stop);
+}
 
 }  // namespace
 
@@ -81,7 +83,8 @@ void MpiSession::send(int to, wire::Tag tag, const wire::Bytes& bytes, double ti
   check(MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, to, static_cast<int>(tag), MPI_COMM_WORLD,
                   &request),
         "MPI_Isend");
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
   PollWait wait;
   for (;;) {
     int done = 0;

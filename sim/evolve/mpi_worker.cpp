@@ -33,8 +33,7 @@ void serve_evaluations(MpiSession& session, int threads, const TeamFunctionFacto
                          std::to_string(message->from));
       }
       switch (message->tag) {
-        case wire::Tag::stop:
-          return;  // ~TeamWorkers waits for the teams being evaluated
+        case wire::Tag::stop: return;  // ~TeamWorkers waits for the teams being evaluated
         case wire::Tag::setup: {
           if (!jobs.empty()) throw MpiFailure(me + ": a new setup arrived while teams were being evaluated");
           workers.reset();

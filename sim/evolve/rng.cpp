@@ -8,9 +8,7 @@
 
 namespace tensegrity::sim::evolve {
 
-double Rng::uniform01() {
-  return static_cast<double>(engine_() >> 11) * 0x1.0p-53;
-}
+double Rng::uniform01() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
 
 std::size_t Rng::below(std::size_t n) {
   if (n == 0) throw std::invalid_argument("Rng::below(0)");

@@ -70,7 +70,8 @@ class RealEndcaps : public ::testing::Test {
     observer_.reset();
     if (HasFailure()) {
       for (int e = 0; e < kEndcapCount; ++e) {
-        std::printf("--- endcap %d stderr (tail)\n%s", e, tail(read(dir_ / ("endcap" + std::to_string(e) + ".err"))).c_str());
+        std::printf("--- endcap %d stderr (tail)\n%s", e,
+                    tail(read(dir_ / ("endcap" + std::to_string(e) + ".err"))).c_str());
       }
     }
     fs::remove_all(dir_);
@@ -87,7 +88,10 @@ class RealEndcaps : public ::testing::Test {
         {"nodes", {{"drives", {1, 3}}, {"load_cell", 2}}},  // endcap_device_sim's node ids
         {"spool", {{"radius_m", 0.01}, {"counts_per_rev", 446464}}},
         {"limits",
-         {{"min_rest_length_m", 0.6}, {"max_rest_length_m", 1.1}, {"speed_m_per_s", 0.2}, {"cutoff_tension_n", 400},
+         {{"min_rest_length_m", 0.6},
+          {"max_rest_length_m", 1.1},
+          {"speed_m_per_s", 0.2},
+          {"cutoff_tension_n", 400},
           {"hard_limit_tension_n", 500}}},
         {"initial_rest_length_m", 0.95},
         {"storage_dir", (dir_ / ("store" + tag)).string()},
@@ -97,10 +101,13 @@ class RealEndcaps : public ::testing::Test {
         // load average 50 with 1 kHz and 0.5-1 s).
         {"loop", {{"rate_hz", 250}, {"mode", "realtime"}}},
         {"timeouts",
-         {{"drive_heartbeat_s", 3.0}, {"load_cell_heartbeat_s", 3.0}, {"load_cell_sample_s", 2.0},
+         {{"drive_heartbeat_s", 3.0},
+          {"load_cell_heartbeat_s", 3.0},
+          {"load_cell_sample_s", 2.0},
           // Seen in a fresh-clone CI run: a 20 ms position gap (the default) latched
           // stale_position on one end cap.
-          {"drive_position_s", 2.0}, {"drive_consumer_heartbeat_s", 1.0}}},
+          {"drive_position_s", 2.0},
+          {"drive_consumer_heartbeat_s", 1.0}}},
     };
     const fs::path config_file = dir_ / ("endcap" + tag + ".json");
     std::ofstream(config_file) << config.dump(2);
@@ -162,17 +169,22 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   const std::int64_t t0 = Station::now_ns();
   ASSERT_TRUE(observer_->wait_for_endcaps(kAllEndcaps, false, t0 + 20'000'000'000))
       << "not every end cap's DDS node came up: " << seen_text();
-  std::printf("MEASURE discovery of 12 end-cap processes: %.0f ms\n", static_cast<double>(Station::now_ns() - t0) / 1e6);
+  std::printf("MEASURE discovery of 12 end-cap processes: %.0f ms\n",
+              static_cast<double>(Station::now_ns() - t0) / 1e6);
 
   // 1. Upload through the program an operator uses.
   const fs::path policy = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
   std::string out;
-  ASSERT_EQ(tensegrity({"upload", policy.string(), "--id", "e2e_gait", "--policy-version", "3", "--timeout", "20"}, out), 0);
+  ASSERT_EQ(
+      tensegrity({"upload", policy.string(), "--id", "e2e_gait", "--policy-version", "3", "--timeout", "20"}, out), 0);
   EXPECT_NE(out.find("all 12 end caps accepted"), std::string::npos);
-  EXPECT_TRUE(wait_all([](const EndcapStatus& s) {
-    return s.have_telemetry && s.telemetry.active_policy_id().to_string() == "e2e_gait" &&
-           s.telemetry.active_policy_version() == 3U;
-  }, 5.0)) << "the end caps' telemetry does not report the uploaded policy";
+  EXPECT_TRUE(wait_all(
+      [](const EndcapStatus& s) {
+        return s.have_telemetry && s.telemetry.active_policy_id().to_string() == "e2e_gait" &&
+               s.telemetry.active_policy_version() == 3U;
+      },
+      5.0))
+      << "the end caps' telemetry does not report the uploaded policy";
 
   // 2. Upload latency to the 12 real end caps (idle loops take a table at once):
   // the same ground::upload code, successive versions, first write to last ack.
@@ -226,8 +238,10 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
     for (int e = 0; e < kEndcapCount; ++e) slowest = std::min(slowest, last_seq[e] - first_seq[e]);
     // The quantity asserted below (sequence span of the running samples received, which
     // may begin a little before the window) per second of the window: a margin, not a rate meter.
-    std::printf("MEASURE running_telemetry_sent_slowest_endcap_hz=%.1f (span %u over %.2f s; configured 100, asserted span > 50)\n",
-                static_cast<double>(slowest) / window_s, slowest, window_s);
+    std::printf(
+        "MEASURE running_telemetry_sent_slowest_endcap_hz=%.1f (span %u over %.2f s; configured 100, asserted span > "
+        "50)\n",
+        static_cast<double>(slowest) / window_s, slowest, window_s);
     for (int e = 0; e < kEndcapCount; ++e) {
       const auto i = static_cast<std::size_t>(e);
       const std::string seen = " (all running: " + std::to_string(all_running) + ", telemetry samples " +
@@ -236,7 +250,8 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
                                std::to_string(unsigned{snap[i].telemetry.mode()}) + ")";
       // Sent (by sequence number) is the end cap's doing; received is a best-effort
       // reader's on a loaded 2-core machine, which may drop many: ask only for some.
-      EXPECT_GT(last_seq[i] - first_seq[i], 50U) << "end cap " << e << ": too little telemetry sent in mode running" << seen;
+      EXPECT_GT(last_seq[i] - first_seq[i], 50U)
+          << "end cap " << e << ": too little telemetry sent in mode running" << seen;
       EXPECT_GE(running_samples[i], 5U) << "end cap " << e << ": too little telemetry received in mode running" << seen;
       // 0.2 m/s for 2 s toward a table 0.6..0.96 m: well over 1 cm.
       EXPECT_GT(hi[i] - lo[i], 0.01) << "end cap " << e << ": commanded rest length of motor 0 did not move" << seen;

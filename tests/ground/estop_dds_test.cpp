@@ -174,8 +174,7 @@ TEST_F(Estop, LandsUnderAForgedClock) {
   ASSERT_TRUE(clear.all_accepted()) << format_command_report(clear);
   const std::int64_t worst_clear = expect_all_within("CLEARED", cleared_sent, kBoundNs);
   std::printf("MEASURE forged_clock estop_worst_ms=%.1f clear_fault_worst_ms=%.1f bound=%.0f rogue_answers=%llu\n",
-              ms(worst_estop), ms(worst_clear), ms(kBoundNs),
-              static_cast<unsigned long long>(rogue.answered()));
+              ms(worst_estop), ms(worst_clear), ms(kBoundNs), static_cast<unsigned long long>(rogue.answered()));
 }
 
 TEST_F(Estop, LandsThroughAFullCommandQueue) {

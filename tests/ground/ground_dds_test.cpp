@@ -68,7 +68,8 @@ class GroundDds : public ::testing::Test {
     std::vector<std::string> argv{COMMS_TEST_NODE, "--domain", std::to_string(domain)};
     argv.insert(argv.end(), extra.begin(), extra.end());
     const std::string tag = std::to_string(nodes_.size());
-    nodes_.push_back(std::make_unique<Subprocess>(argv, dir_ / ("nodes" + tag + ".out"), dir_ / ("nodes" + tag + ".err")));
+    nodes_.push_back(
+        std::make_unique<Subprocess>(argv, dir_ / ("nodes" + tag + ".out"), dir_ / ("nodes" + tag + ".err")));
     EXPECT_TRUE(nodes_.back()->wait_for_output("READY", std::chrono::seconds(20)));
     return *nodes_.back();
   }
@@ -166,16 +167,48 @@ TEST_F(GroundDds, EveryBadPolicyIsRejectedWithItsReasonAndTheOldOneKeepsRunning)
   };
   static auto re = +[](msg::PolicyTable_& m) { m.checksum(fw::comms::policy_checksum(m)); };
   const Case cases[] = {
-      {"wrong end cap", [](msg::PolicyTable_& m) { m.endcap_id(static_cast<std::int16_t>(m.endcap_id() + 1)); re(m); },
+      {"wrong end cap",
+       [](msg::PolicyTable_& m) {
+         m.endcap_id(static_cast<std::int16_t>(m.endcap_id() + 1));
+         re(m);
+       },
        PolicyReason::wrong_endcap},
-      {"wrong count", [](msg::PolicyTable_& m) { m.motor_count(3); re(m); }, PolicyReason::bad_motor_count},
-      {"short values", [](msg::PolicyTable_& m) { m.rest_length_m().pop_back(); re(m); }, PolicyReason::bad_size},
-      {"NaN", [](msg::PolicyTable_& m) { m.rest_length_m()[1] = std::nan(""); re(m); }, PolicyReason::non_finite_value},
-      {"out of range", [](msg::PolicyTable_& m) { m.rest_length_m()[1] = 2.5; re(m); },
+      {"wrong count",
+       [](msg::PolicyTable_& m) {
+         m.motor_count(3);
+         re(m);
+       },
+       PolicyReason::bad_motor_count},
+      {"short values",
+       [](msg::PolicyTable_& m) {
+         m.rest_length_m().pop_back();
+         re(m);
+       },
+       PolicyReason::bad_size},
+      {"NaN",
+       [](msg::PolicyTable_& m) {
+         m.rest_length_m()[1] = std::nan("");
+         re(m);
+       },
+       PolicyReason::non_finite_value},
+      {"out of range",
+       [](msg::PolicyTable_& m) {
+         m.rest_length_m()[1] = 2.5;
+         re(m);
+       },
        PolicyReason::value_out_of_limits},
       {"bad checksum", [](msg::PolicyTable_& m) { m.checksum(m.checksum() + 1); }, PolicyReason::bad_checksum},
-      {"stale version", [](msg::PolicyTable_& m) { m.policy_version(4); re(m); }, PolicyReason::stale_version},
-      {"same version, other values", [](msg::PolicyTable_& m) { m.rest_length_m()[0] += 0.01; re(m); },
+      {"stale version",
+       [](msg::PolicyTable_& m) {
+         m.policy_version(4);
+         re(m);
+       },
+       PolicyReason::stale_version},
+      {"same version, other values",
+       [](msg::PolicyTable_& m) {
+         m.rest_length_m()[0] += 0.01;
+         re(m);
+       },
        PolicyReason::stale_version},
       {"wrong message version", [](msg::PolicyTable_& m) { m.format_version(msgs::kFormatVersion + 1); },
        PolicyReason::wrong_format_version},
@@ -237,8 +270,9 @@ TEST_F(GroundDds, StartAtHostTimePutsAllTwelveInPhase) {
   const auto snap = s.snapshot();
   std::int64_t worst_rtt = 0;
   for (const auto& e : snap) worst_rtt = std::max(worst_rtt, e.heartbeat.clock_round_trip_ns());
-  std::printf("MEASURE start_skew_us spread=%.1f worst_vs_target=%.1f worst_sync_rtt=%.1f\n", static_cast<double>(hi - lo) / 1e3,
-              static_cast<double>(worst_vs_t) / 1e3, static_cast<double>(worst_rtt) / 1e3);
+  std::printf("MEASURE start_skew_us spread=%.1f worst_vs_target=%.1f worst_sync_rtt=%.1f\n",
+              static_cast<double>(hi - lo) / 1e3, static_cast<double>(worst_vs_t) / 1e3,
+              static_cast<double>(worst_rtt) / 1e3);
   // Loopback: the bound is half the round trip (tens of microseconds); 2 ms leaves
   // room for a loaded 2-core machine.
   EXPECT_LT(hi - lo, 2'000'000);

@@ -48,14 +48,16 @@ TEST_F(Keystore, InitMakesSros2sLayoutWithSignedDocuments) {
     }
     EXPECT_EQ(sh("openssl verify -CAfile " + ca.string() + " " + (e / "cert.pem").string()), 0);
     // The certificate's subject is the one the permissions grant names.
-    EXPECT_EQ(sh("openssl x509 -in " + (e / "cert.pem").string() + " -noout -subject -nameopt RFC2253 | grep -qx 'subject=" +
-                 msgs::subject_name(enclave) + "'"),
+    EXPECT_EQ(sh("openssl x509 -in " + (e / "cert.pem").string() +
+                 " -noout -subject -nameopt RFC2253 | grep -qx 'subject=" + msgs::subject_name(enclave) + "'"),
               0);
-    EXPECT_EQ(fs::status(e / "key.pem").permissions() & (fs::perms::group_all | fs::perms::others_all), fs::perms::none);
+    EXPECT_EQ(fs::status(e / "key.pem").permissions() & (fs::perms::group_all | fs::perms::others_all),
+              fs::perms::none);
   }
-  EXPECT_EQ(sh("openssl smime -verify -in " + (msgs::enclave_dir(ks, "/tensegrity/ground") / "permissions.p7s").string() +
-               " -CAfile " + ca.string() + " | grep -q 'rt/tensegrity/command'"),
-            0);
+  EXPECT_EQ(
+      sh("openssl smime -verify -in " + (msgs::enclave_dir(ks, "/tensegrity/ground") / "permissions.p7s").string() +
+         " -CAfile " + ca.string() + " | grep -q 'rt/tensegrity/command'"),
+      0);
 }
 
 TEST_F(Keystore, AnExistingKeystoreIsKeptUnlessReplaced) {

@@ -194,8 +194,8 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
         << "a writer outside end cap 1's partition";
   }
   dds::Publisher* own = impostor->create_publisher(msgs::endcap_publisher_qos(1));
-  dds::DataWriter* beats =
-      msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()));
+  dds::DataWriter* beats = msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic,
+                                               dds::TypeSupport(new m::Heartbeat_PubSubType()));
   dds::DataWriter* acks =
       msgs::create_writer(*impostor, *own, msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
   m::Heartbeat_ hb;

@@ -32,7 +32,8 @@ std::array<EndcapStatus, kEndcapCount> seen(std::initializer_list<int> endcaps) 
 std::vector<int> rows(const std::string& table) {
   std::vector<int> out;
   const std::regex row(R"(^\s+(\d+)\s)", std::regex::multiline);
-  for (std::sregex_iterator it(table.begin(), table.end(), row), end; it != end; ++it) out.push_back(std::stoi((*it)[1]));
+  for (std::sregex_iterator it(table.begin(), table.end(), row), end; it != end; ++it)
+    out.push_back(std::stoi((*it)[1]));
   return out;
 }
 

@@ -15,7 +15,9 @@ namespace {
 
 using namespace fw::canopen;
 
-CanFrame rpdo(std::uint8_t node, std::uint16_t cw, std::int32_t target) { return encode_drive_rpdo1(node, {cw, target}); }
+CanFrame rpdo(std::uint8_t node, std::uint16_t cw, std::int32_t target) {
+  return encode_drive_rpdo1(node, {cw, target});
+}
 
 // Power on, NMT start, CSP by SDO-free shortcut (od_write through SDO is tested in
 // the driver tests), then the CiA 402 power-up controlwords.

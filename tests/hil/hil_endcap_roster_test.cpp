@@ -94,10 +94,12 @@ TEST(HilEndcapRoster, WaitsForARestartedProgramAndNamesOneThatExits) {
     return 0;
   };
   const std::string why = error_of([&] { roster.await_restarted(clock, stop.get_token(), 1'000'000'000, 7); });
-  EXPECT_EQ(why, "lockstep: end cap 4's restarted program exited before it listened on its bus (physics step 7): fake 4");
+  EXPECT_EQ(why,
+            "lockstep: end cap 4's restarted program exited before it listened on its bus (physics step 7): fake 4");
   processes.exited_set.clear();
-  EXPECT_NE(error_of([&] { roster.await_restarted(clock, stop.get_token(), 1'000'000'000, 9); })
-                .find("not listening on its bus within 1 s (physics step 9): end cap 4 (fake 4);"),
+  EXPECT_NE(error_of([&] {
+              roster.await_restarted(clock, stop.get_token(), 1'000'000'000, 9);
+            }).find("not listening on its bus within 1 s (physics step 9): end cap 4 (fake 4);"),
             std::string::npos);
   stop.request_stop();
   EXPECT_EQ(error_of([&] { roster.await_restarted(clock, stop.get_token(), 1'000'000'000, 9); }), "interrupted");

@@ -15,7 +15,8 @@ constexpr double kDtS = 0.001;
 class RecordingTarget final : public FaultTarget {
  public:
   RecordingTarget() {
-    for (int e = 0; e < 3; ++e) devices_.emplace_back(e, std::vector<int>{2 * e, 2 * e + 1}, fw::SpoolGeometry{}, 1.1, true);
+    for (int e = 0; e < 3; ++e)
+      devices_.emplace_back(e, std::vector<int>{2 * e, 2 * e + 1}, fw::SpoolGeometry{}, 1.1, true);
   }
   int endcap_count() const override { return static_cast<int>(devices_.size()); }
   EndcapDevices& devices(int e) override { return devices_.at(static_cast<std::size_t>(e)); }
@@ -70,9 +71,9 @@ TEST(HilFaultInjector, EventsBecomeActionsInTheStepTheyAreDue) {
   drop.duration_s = 0.010;
   FaultParams corrupt;
   corrupt.probability = 0.25;
-  s.events = {event(0.0, 2, FaultKind::load_cell_stuck), event(0.005, 1, FaultKind::drop_frames, drop),
+  s.events = {event(0.0, 2, FaultKind::load_cell_stuck),           event(0.005, 1, FaultKind::drop_frames, drop),
               event(0.005, 0, FaultKind::corrupt_frames, corrupt), event(0.020, 2, FaultKind::kill_endcap),
-              event(0.0305, 2, FaultKind::restart_endcap), event(0.040, -1, FaultKind::cut_dds)};
+              event(0.0305, 2, FaultKind::restart_endcap),         event(0.040, -1, FaultKind::cut_dds)};
   FaultInjector injector(s, kDtS);
   RecordingTarget target;
   std::vector<std::string> log;

@@ -33,8 +33,8 @@ struct Rig {
     std::string error;
     const bool batch[2] = {batch0, batch1};
     for (int e = 0; e < 2; ++e) {
-      endcap[e] = fw::UdpCanBus::open({fw::UdpEndpoint{"127.0.0.1", hub.port()}, fw::UdpEndpoint{"127.0.0.1", 0}, batch[e]},
-                                      error);
+      endcap[e] = fw::UdpCanBus::open(
+          {fw::UdpEndpoint{"127.0.0.1", hub.port()}, fw::UdpEndpoint{"127.0.0.1", 0}, batch[e]}, error);
       EXPECT_TRUE(endcap[e]) << error;
       hub.set_endcap_port(e, endcap[e]->local_port());
     }
@@ -188,7 +188,8 @@ TEST(LauncherPorts, DistinctFreeAndBelowTheEphemeralRange) {
   std::vector<std::unique_ptr<fw::UdpCanBus>> buses;
   for (const std::uint16_t p : ports) {
     std::string error;
-    buses.push_back(fw::UdpCanBus::open({fw::UdpEndpoint{"127.0.0.1", 9}, fw::UdpEndpoint{"127.0.0.1", p}, false}, error));
+    buses.push_back(
+        fw::UdpCanBus::open({fw::UdpEndpoint{"127.0.0.1", 9}, fw::UdpEndpoint{"127.0.0.1", p}, false}, error));
     EXPECT_NE(buses.back(), nullptr) << p << ": " << error;
   }
 }

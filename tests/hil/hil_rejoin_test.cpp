@@ -77,12 +77,14 @@ TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
 constexpr double kSameTickS = 1e-9;
 #ifdef TENSEGRITY_HIL_DDS
 // Real time: the time sync error (ms on a loaded host) plus a loop period.
-#define HIL_REJOIN_CASES                                                              \
-  RejoinCase{StepperMode::lockstep, Provision::local, kSameTickS},                    \
-      RejoinCase{StepperMode::lockstep, Provision::dds, kSameTickS},                  \
-      RejoinCase{StepperMode::realtime, Provision::dds, 0.005}
+#define HIL_REJOIN_CASES                                                          \
+  RejoinCase{StepperMode::lockstep, Provision::local, kSameTickS},                \
+      RejoinCase{StepperMode::lockstep, Provision::dds, kSameTickS}, RejoinCase { \
+    StepperMode::realtime, Provision::dds, 0.005                                  \
+  }
 #else
-#define HIL_REJOIN_CASES RejoinCase{StepperMode::lockstep, Provision::local, kSameTickS}
+#define HIL_REJOIN_CASES \
+  RejoinCase { StepperMode::lockstep, Provision::local, kSameTickS }
 #endif
 INSTANTIATE_TEST_SUITE_P(Modes, HilRejoin, ::testing::Values(HIL_REJOIN_CASES),
                          [](const ::testing::TestParamInfo<RejoinCase>& i) {

@@ -65,18 +65,20 @@ TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
     // Not asserted: at full lockstep speed the emulator and the loops (real-time
     // priority) can starve the DDS threads on a loaded 2-core host long enough for
     // an end cap to call its host lost (docs/hil.md); the gait is open loop.
-    if (e.host_losses > 0) std::printf("end cap %d reported %llu host loss(es)\n", e.endcap, static_cast<unsigned long long>(e.host_losses));
+    if (e.host_losses > 0)
+      std::printf("end cap %d reported %llu host loss(es)\n", e.endcap, static_cast<unsigned long long>(e.host_losses));
   }
   EXPECT_TRUE(child_pids().empty()) << "end-cap processes left behind";
   EXPECT_EQ(dds_shm_files(), shm_before) << "shared-memory files left in /dev/shm";
   for (const auto& line : r.log) {
     if (line.rfind("dds:", 0) == 0) std::printf("%s\n", line.c_str());
   }
-  std::printf("fidelity (%s): HIL %.6f m, in-process %.6f m (%+.5f%%), %.1fx real time (send %.2f s, barrier %.2f s, "
-              "physics %.2f s), hold %.3f s\n",
-              to_string(GetParam()), r.distance_m, ref.distance_m,
-              100.0 * (r.distance_m - ref.distance_m) / ref.distance_m, r.stats.sim_time_s() / r.stats.run_wall_s,
-              r.stats.send_wall_s, r.stats.barrier_wall_s, r.stats.physics_wall_s, r.stats.hold_wall_s);
+  std::printf(
+      "fidelity (%s): HIL %.6f m, in-process %.6f m (%+.5f%%), %.1fx real time (send %.2f s, barrier %.2f s, "
+      "physics %.2f s), hold %.3f s\n",
+      to_string(GetParam()), r.distance_m, ref.distance_m, 100.0 * (r.distance_m - ref.distance_m) / ref.distance_m,
+      r.stats.sim_time_s() / r.stats.run_wall_s, r.stats.send_wall_s, r.stats.barrier_wall_s, r.stats.physics_wall_s,
+      r.stats.hold_wall_s);
 }
 
 #ifdef TENSEGRITY_HIL_DDS

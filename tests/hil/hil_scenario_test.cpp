@@ -37,7 +37,8 @@ TEST(HilScenario, ErrorsNameTheField) {
   };
   EXPECT_EQ(message(R"([{"time_s": 1, "endcap": 12, "fault": "kill_endcap"}])"),
             "s.json: events[0].endcap: endcap 12 out of range 0..11");
-  EXPECT_NE(message(R"([{"time_s": 1, "endcap": 1, "fault": "explode"}])").find("unknown fault 'explode'"), std::string::npos);
+  EXPECT_NE(message(R"([{"time_s": 1, "endcap": 1, "fault": "explode"}])").find("unknown fault 'explode'"),
+            std::string::npos);
   EXPECT_EQ(message(R"([{"time_s": 1, "endcap": 1, "fault": "drop_frames", "params": {"probabilty": 1}}])"),
             "s.json: events[0].params.probabilty: unknown parameter");
 }

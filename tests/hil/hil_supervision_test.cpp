@@ -21,9 +21,9 @@ namespace {
 using namespace hil_test;
 using fw::canopen::Cia402State;
 
-constexpr std::int64_t kPeriodNs = 1'000'000;           // the HIL's control period
-constexpr std::int64_t kProducerNs = 10'000'000;        // end cap heartbeat (default config)
-constexpr std::int64_t kConsumerNs = 50'000'000;        // drives' 0x1016 (default: 5 x producer)
+constexpr std::int64_t kPeriodNs = 1'000'000;     // the HIL's control period
+constexpr std::int64_t kProducerNs = 10'000'000;  // end cap heartbeat (default config)
+constexpr std::int64_t kConsumerNs = 50'000'000;  // drives' 0x1016 (default: 5 x producer)
 
 double ms(std::int64_t ns) { return static_cast<double>(ns) * 1e-6; }
 
@@ -39,7 +39,7 @@ ScenarioEvent event(double time_s, int endcap, FaultKind fault, int motor = 0) {
 // Per physics step, what the drives of one end cap did.
 struct DriveWatch {
   int endcap = 0;
-  std::int64_t fault_step = -1;        // the step the scenario's fault was applied in
+  std::int64_t fault_step = -1;          // the step the scenario's fault was applied in
   std::int64_t safe_step[2] = {-1, -1};  // first step a drive was out of operation enabled
   void observe(const WorldStepper& s, bool fault_applied) {
     if (fault_applied && fault_step < 0) fault_step = s.step_index();
@@ -92,7 +92,8 @@ struct SilenceWatch {
   Drive drives[2];
   std::int64_t fault_step = -1;
   void observe(const WorldStepper& s) {
-    if (fault_step < 0 && !s.log().empty() && s.log().back().find("end cap " + std::to_string(endcap)) != std::string::npos) {
+    if (fault_step < 0 && !s.log().empty() &&
+        s.log().back().find("end cap " + std::to_string(endcap)) != std::string::npos) {
       fault_step = s.step_index();
     }
     for (int m = 0; m < 2; ++m) {
@@ -129,9 +130,10 @@ void expect_drives_stop_by_themselves(const HilResult& r, const SilenceWatch& sn
     EXPECT_LE(detection_ns, consumer_ns + kPeriodNs) << "detection bounded by the consumer heartbeat time";
     EXPECT_GE(safe_ns, 0);
     EXPECT_LE(safe_ns, 2 * kPeriodNs) << "safe state within 2 control periods of detection";
-    std::printf("MEASURE %s end cap %d drive %d: last end-cap heartbeat -> detection %.1f ms (consumer %.0f ms, "
-                "producer %.0f ms); detection -> quick stop %.1f ms; fault injected -> detection %.1f ms\n",
-                what, endcap, m, ms(detection_ns), ms(consumer_ns), ms(kProducerNs), ms(safe_ns), ms(since_fault_ns));
+    std::printf(
+        "MEASURE %s end cap %d drive %d: last end-cap heartbeat -> detection %.1f ms (consumer %.0f ms, "
+        "producer %.0f ms); detection -> quick stop %.1f ms; fault injected -> detection %.1f ms\n",
+        what, endcap, m, ms(detection_ns), ms(consumer_ns), ms(kProducerNs), ms(safe_ns), ms(since_fault_ns));
   }
   for (const auto& other : r.endcaps) {
     if (other.endcap != endcap) {

@@ -57,7 +57,8 @@ inline const fs::path& policy_file() {
     p.provenance.method = "hand";
     for (int m = 0; m < robot().cable_count(); ++m) {
       sim::CablePolicy c{m, robot().cables[m].owner, {}};
-      for (int j = 0; j < 5; ++j) c.rest_lengths_m.push_back(0.85 + 0.15 * std::sin(2 * M_PI * j / 5 + 2 * M_PI * m / 24));
+      for (int j = 0; j < 5; ++j)
+        c.rest_lengths_m.push_back(0.85 + 0.15 * std::sin(2 * M_PI * j / 5 + 2 * M_PI * m / 24));
       p.cables.push_back(c);
     }
     const fs::path f = fs::temp_directory_path() / ("hil_test_policy_" + std::to_string(::getpid()) + ".json");

@@ -18,8 +18,8 @@ TEST(EndcapPartitions, NamesRoundTrip) {
 }
 
 TEST(EndcapPartitions, AnyOtherNameIsNoEndcap) {
-  for (const char* name : {"", "endcap_*", "endcap_12", "endcap_3", "endcap_003", "endcap_-1", "Endcap_03",
-                           "endcap_0a", "xendcap_03", "endcap_03 "}) {
+  for (const char* name : {"", "endcap_*", "endcap_12", "endcap_3", "endcap_003", "endcap_-1", "Endcap_03", "endcap_0a",
+                           "xendcap_03", "endcap_03 "}) {
     EXPECT_EQ(endcap_of_partition(name), -1) << name;
   }
 }

@@ -28,8 +28,8 @@ TEST(Security, OnlyTheGroundMayPublishOrders) {
     EXPECT_FALSE(may_publish(Role::endcap, t)) << t.name;
     EXPECT_FALSE(may_publish(Role::listener, t)) << t.name;
   }
-  for (const TopicSpec& t : {kPolicyAckTopic, kCommandAckTopic, kTelemetryTopic, kEndcapHeartbeatTopic,
-                             kTimeSyncRequestTopic}) {
+  for (const TopicSpec& t :
+       {kPolicyAckTopic, kCommandAckTopic, kTelemetryTopic, kEndcapHeartbeatTopic, kTimeSyncRequestTopic}) {
     EXPECT_FALSE(may_publish(Role::ground, t)) << t.name;
     EXPECT_TRUE(may_publish(Role::endcap, t)) << t.name;
     EXPECT_FALSE(may_subscribe(Role::endcap, t)) << t.name << ": an end cap reads no other end cap";

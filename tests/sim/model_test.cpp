@@ -88,8 +88,7 @@ TEST(Model, EnergyConservedWithoutGravityGroundAndDamping) {
   for (int s = 0; s < 6; ++s) {
     const auto& strut = robot.struts[s];
     const Eigen::Vector3d mid = 0.5 * (robot.nodes_m[strut.node_a] + robot.nodes_m[strut.node_b]) - centre;
-    model.set_velocity(s, -0.3 * mid + Eigen::Vector3d(0.0, 0.0, 0.05 * s),
-                       Eigen::Vector3d(0.4, -0.2 + 0.1 * s, 0.3));
+    model.set_velocity(s, -0.3 * mid + Eigen::Vector3d(0.0, 0.0, 0.05 * s), Eigen::Vector3d(0.4, -0.2 + 0.1 * s, 0.3));
   }
   const std::vector<double> hold(24, robot.initial_rest_length_m);
   const double e0 = model.kinetic_energy_j() + model.elastic_energy_j();
@@ -116,7 +115,8 @@ TEST(Model, StrutCannotWheelAboutItsOwnAxis) {
     model.restore(settled_state(robot, r.time_step_s));
     const Eigen::Vector3d start = model.centre_m();
     for (int s = 0; s < 6; ++s) {
-      const Eigen::Vector3d axis = (model.node_position(r.struts[s].node_b) - model.node_position(r.struts[s].node_a)).normalized();
+      const Eigen::Vector3d axis =
+          (model.node_position(r.struts[s].node_b) - model.node_position(r.struts[s].node_a)).normalized();
       model.set_velocity(s, Eigen::Vector3d::Zero(), 30.0 * axis);
     }
     run(model, seconds, hold);
@@ -176,8 +176,8 @@ TEST(Model, SurfaceAttachedCablesStopAStrutsSpin) {
     const double r = robot.strut_radius_m;
     const double cylinder = M_PI * r * r * (b - a).norm(), spheres = 4.0 / 3.0 * M_PI * r * r * r;
     const double m = robot.strut_mass_kg;
-    const double inertia = (m * cylinder / (cylinder + spheres)) * r * r / 2.0 +
-                           (m * spheres / (cylinder + spheres)) * 2.0 * r * r / 5.0;
+    const double inertia =
+        (m * cylinder / (cylinder + spheres)) * r * r / 2.0 + (m * spheres / (cylinder + spheres)) * 2.0 * r * r / 5.0;
     const double theta_max = kSpin * std::sqrt(inertia / k);
     model.step(hold);
     const std::uint32_t ends = (std::uint32_t{1} << strut.node_a) | (std::uint32_t{1} << strut.node_b);

@@ -14,8 +14,8 @@
 namespace tensegrity::sim {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 class PolicyFile : public ::testing::Test {
  protected:

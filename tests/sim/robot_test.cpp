@@ -11,8 +11,8 @@
 namespace tensegrity::sim {
 namespace {
 
-using ::testing::HasSubstr;
 using nlohmann::json;
+using ::testing::HasSubstr;
 
 json superball_json() {
   std::ifstream in(default_robot_path());

@@ -108,11 +108,12 @@ TEST(LiveBridge, HasNoWriterAndForwardsTelemetryToThePage) {
   // end cap 5's partition claims to be end cap 3.
   dds::Publisher* publisher = peer->create_publisher(msgs::endcap_publisher_qos(3));
   dds::Publisher* impostor_publisher = peer->create_publisher(msgs::endcap_publisher_qos(5));
-  dds::DataWriter* writer = msgs::create_writer(*peer, *publisher, msgs::kTelemetryTopic,
-                                                dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
-  dds::DataWriter* impostor = msgs::create_writer(
-      *peer, *impostor_publisher, msgs::kTelemetryTopic,
-      dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
+  dds::DataWriter* writer =
+      msgs::create_writer(*peer, *publisher, msgs::kTelemetryTopic,
+                          dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
+  dds::DataWriter* impostor =
+      msgs::create_writer(*peer, *impostor_publisher, msgs::kTelemetryTopic,
+                          dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
   const sim::Robot robot = sim::load_robot(sim::default_robot_path());
   EventHub hub;
   std::uint64_t cursor = hub.head();

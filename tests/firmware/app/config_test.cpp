@@ -111,7 +111,10 @@ std::string policy_json(double value_for_cable_5) {
   for (int c = 0; c < 24; ++c) {
     cables.push_back({{"cable", c}, {"owner", c / 2}, {"rest_lengths_m", {0.9, c == 5 ? value_for_cable_5 : 1.0}}});
   }
-  return json{{"format", "tensegrity-policy/1"}, {"robot", "superball"}, {"period_s", 1.2}, {"complexity", 2},
+  return json{{"format", "tensegrity-policy/1"},
+              {"robot", "superball"},
+              {"period_s", 1.2},
+              {"complexity", 2},
               {"cables", cables}}
       .dump();
 }
@@ -177,8 +180,9 @@ void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
 TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
   json full = example();
   full["nodes"] = {{"drives", {5}}, {"load_cell", nullptr}, {"endcap", 100}};
-  full["timeouts"] = {{"drive_heartbeat_s", 0.25}, {"load_cell_heartbeat_s", 0.3}, {"load_cell_sample_s", 0.05},
-                      {"drive_position_s", 0.04}, {"endcap_heartbeat_s", 0.02}, {"drive_consumer_heartbeat_s", 0.07}};
+  full["timeouts"] = {{"drive_heartbeat_s", 0.25},  {"load_cell_heartbeat_s", 0.3},
+                      {"load_cell_sample_s", 0.05}, {"drive_position_s", 0.04},
+                      {"endcap_heartbeat_s", 0.02}, {"drive_consumer_heartbeat_s", 0.07}};
   full["drive_abort_connection"] = "fault";
   full["start_on_boot"] = true;
   full["stats_log_period_s"] = 2.5;
@@ -209,12 +213,15 @@ TEST(EndcapConfig, SupervisionErrorsNameTheField) {
     j["timeouts"][key] = value;
     return j;
   };
-  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.0105)), HasSubstr("timeouts.endcap_heartbeat_s: must be a whole number of milliseconds"));
-  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.001)), HasSubstr("timeouts.endcap_heartbeat_s: must be at least one loop period"));
+  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.0105)),
+              HasSubstr("timeouts.endcap_heartbeat_s: must be a whole number of milliseconds"));
+  EXPECT_THAT(error_of(with("endcap_heartbeat_s", 0.001)),
+              HasSubstr("timeouts.endcap_heartbeat_s: must be at least one loop period"));
   EXPECT_THAT(error_of(with("endcap_heartbeat_s", 70.0)), HasSubstr("timeouts.endcap_heartbeat_s"));
   EXPECT_THAT(error_of(with("drive_consumer_heartbeat_s", 0.015)),
               HasSubstr("timeouts.drive_consumer_heartbeat_s: must be at least twice endcap_heartbeat_s"));
-  EXPECT_THAT(error_of(with("drive_position_s", 0.003)), HasSubstr("timeouts.drive_position_s: must be at least two loop periods"));
+  EXPECT_THAT(error_of(with("drive_position_s", 0.003)),
+              HasSubstr("timeouts.drive_position_s: must be at least two loop periods"));
   EXPECT_THAT(error_of(with("drive_position_s", -1)), HasSubstr("timeouts.drive_position_s: must be > 0"));
   json j = example();
   j["drive_abort_connection"] = "none";

@@ -111,7 +111,7 @@ TEST(ControlLoop, OverTensionTripsAndHoldsInTheCycleThatReadsIt) {
   ASSERT_TRUE(b.start_running());
   for (int i = 0; i < 50; ++i) b.cycle();
   b.load_cell.sample.tension_mn[1] = 600'000;  // 600 N > 500 N hard limit
-  b.cycle();  // SYNC of this cycle makes the load cell send it
+  b.cycle();                                   // SYNC of this cycle makes the load cell send it
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
   b.cycle();  // reads it
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::over_tension);

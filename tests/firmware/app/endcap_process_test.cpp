@@ -97,16 +97,22 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
     const bool odd = c % 2 == 1;
     cables.push_back({{"cable", c}, {"owner", c / 2}, {"rest_lengths_m", {odd ? 1.0 : 0.9, odd ? 0.9 : 1.0}}});
   }
-  std::ofstream(dir / "policy.json") << json{{"format", "tensegrity-policy/1"}, {"robot", "superball"},
-                                             {"period_s", 0.4}, {"complexity", 2}, {"cables", cables}}
-                                            .dump();
+  std::ofstream(dir / "policy.json") << json{
+      {"format", "tensegrity-policy/1"},
+      {"robot", "superball"},
+      {"period_s", 0.4},
+      {"complexity", 2},
+      {"cables", cables}}.dump();
   const json config = {
       {"format", "tensegrity-endcap/1"},
       {"bus", "udp:127.0.0.1:" + std::to_string(bus->local_port()) + ",bind=127.0.0.1:" + std::to_string(endcap_port)},
       {"nodes", {{"drives", {3, 5}}, {"load_cell", 4}}},
       {"spool", {{"radius_m", 0.01}, {"counts_per_rev", 446464}}},
       {"limits",
-       {{"min_rest_length_m", 0.6}, {"max_rest_length_m", 1.1}, {"speed_m_per_s", 0.2}, {"cutoff_tension_n", 400},
+       {{"min_rest_length_m", 0.6},
+        {"max_rest_length_m", 1.1},
+        {"speed_m_per_s", 0.2},
+        {"cutoff_tension_n", 400},
         {"hard_limit_tension_n", 500}}},
       {"initial_rest_length_m", 0.95},
       {"storage_dir", (dir / "store").string()},
@@ -127,9 +133,7 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
   sim::SimNode* devices[] = {&drive0, &drive1, &load_cell};
   sim::FrameOut out;
   const auto t0 = Clock::now();
-  const auto now_ns = [&] {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
-  };
+  const auto now_ns = [&] { return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count(); };
   const auto flush = [&] {
     for (const CanFrame& f : out) bus->send(f);
     out.clear();

@@ -123,7 +123,7 @@ TEST_F(PolicyStoreTest, SaveNeverOverwritesTheNewestGoodCopy) {
   std::string error;
   ASSERT_EQ(s.save(table_with(0.7), error), StorageResult::ok);  // generation 1 -> a
   ASSERT_EQ(s.save(table_with(0.8), error), StorageResult::ok);  // generation 2 -> b
-  fs::resize_file(storage.blob_path("table-b"), 3);             // b lost
+  fs::resize_file(storage.blob_path("table-b"), 3);              // b lost
   PolicyStore after_reboot = store();
   StoredTable stored;
   std::string report;

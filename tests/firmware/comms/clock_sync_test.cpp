@@ -30,7 +30,7 @@ TEST(ClockSync, SymmetricExchangeGivesTheExactOffset) {
 TEST(ClockSync, KeepsTheSmallestRoundTripAndStaysWithinItsBound) {
   ClockSyncEstimator est;
   const std::int64_t offset = -3'000'000'000;
-  exchange(est, 0, offset, 900'000, 50'000);       // queued on the way up: skewed
+  exchange(est, 0, offset, 900'000, 50'000);          // queued on the way up: skewed
   exchange(est, 10'000'000, offset, 30'000, 35'000);  // the good one
   exchange(est, 20'000'000, offset, 50'000, 700'000);
   const ClockSample s = est.best();

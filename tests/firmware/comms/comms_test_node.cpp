@@ -83,21 +83,36 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
         return argv[++i];
       };
-      if (arg == "--domain") domain = std::stoi(value());
-      else if (arg == "--endcaps") endcaps = parse_set(value());
-      else if (arg == "--loop-hz") loop_hz = std::stod(value());
-      else if (arg == "--telemetry-hz") base.telemetry_rate_hz = std::stod(value());
-      else if (arg == "--host-loss") base.host_loss = fw::comms::parse_host_loss_action(value());
-      else if (arg == "--stop-on-host-loss") stop_set = parse_set(value());
-      else if (arg == "--host-timeout-s") base.host_timeout_s = std::stod(value());
-      else if (arg == "--clock-offset-spread-s") spread_s = std::stod(value());
-      else if (arg == "--storage") storage_dir = value();
-      else if (arg == "--motor-count") base.expect.motor_count = static_cast<std::uint32_t>(std::stoul(value()));
-      else if (arg == "--quiet") base.log = false;
-      else if (arg == "--stall-commands") stall_commands = true;
-      else if (arg == "--dds-cut-signals") cut_signals = true;
-      else if (arg == "--keystore") keystore = value();
-      else throw std::invalid_argument("unknown argument " + arg);
+      if (arg == "--domain")
+        domain = std::stoi(value());
+      else if (arg == "--endcaps")
+        endcaps = parse_set(value());
+      else if (arg == "--loop-hz")
+        loop_hz = std::stod(value());
+      else if (arg == "--telemetry-hz")
+        base.telemetry_rate_hz = std::stod(value());
+      else if (arg == "--host-loss")
+        base.host_loss = fw::comms::parse_host_loss_action(value());
+      else if (arg == "--stop-on-host-loss")
+        stop_set = parse_set(value());
+      else if (arg == "--host-timeout-s")
+        base.host_timeout_s = std::stod(value());
+      else if (arg == "--clock-offset-spread-s")
+        spread_s = std::stod(value());
+      else if (arg == "--storage")
+        storage_dir = value();
+      else if (arg == "--motor-count")
+        base.expect.motor_count = static_cast<std::uint32_t>(std::stoul(value()));
+      else if (arg == "--quiet")
+        base.log = false;
+      else if (arg == "--stall-commands")
+        stall_commands = true;
+      else if (arg == "--dds-cut-signals")
+        cut_signals = true;
+      else if (arg == "--keystore")
+        keystore = value();
+      else
+        throw std::invalid_argument("unknown argument " + arg);
     }
     if (domain < 0) throw std::invalid_argument("--domain is required");
     if (!(loop_hz > 0.0 && loop_hz <= 10000.0)) throw std::invalid_argument("--loop-hz must be in (0, 10000]");
@@ -138,8 +153,8 @@ int main(int argc, char** argv) {
       }
       if ((stop_set & (1U << e)) != 0) config.host_loss = fw::comms::HostLossAction::stop;
       c.node = std::make_unique<fw::comms::EndcapNode>(config, *c.clock, c.store.get());
-      c.loop = std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count,
-                                                stall_commands);
+      c.loop =
+          std::make_unique<test::StubLoop>(e, *c.node, *c.clock, loop_hz, config.expect.motor_count, stall_commands);
       c.node->start();
       c.loop->start();
       caps.push_back(std::move(c));

@@ -77,20 +77,68 @@ struct BadCase {
 void rechecksum(PolicyTableMsg& m) { m.checksum(policy_checksum(m)); }
 
 const BadCase kBadCases[] = {
-    {"format", [](PolicyTableMsg& m) { m.format_version(msgs::kFormatVersion + 1); }, PolicyReason::wrong_format_version},
-    {"endcap", [](PolicyTableMsg& m) { m.endcap_id(4); rechecksum(m); }, PolicyReason::wrong_endcap},
-    {"robot", [](PolicyTableMsg& m) { m.robot("other"); rechecksum(m); }, PolicyReason::wrong_robot},
-    {"empty_id", [](PolicyTableMsg& m) { m.policy_id(""); rechecksum(m); }, PolicyReason::bad_policy_id},
-    {"motors", [](PolicyTableMsg& m) { m.motor_count(3); rechecksum(m); }, PolicyReason::bad_motor_count},
-    {"complexity", [](PolicyTableMsg& m) { m.complexity(17); rechecksum(m); }, PolicyReason::bad_complexity},
-    {"size", [](PolicyTableMsg& m) { m.rest_length_m().pop_back(); rechecksum(m); }, PolicyReason::bad_size},
+    {"format", [](PolicyTableMsg& m) { m.format_version(msgs::kFormatVersion + 1); },
+     PolicyReason::wrong_format_version},
+    {"endcap",
+     [](PolicyTableMsg& m) {
+       m.endcap_id(4);
+       rechecksum(m);
+     },
+     PolicyReason::wrong_endcap},
+    {"robot",
+     [](PolicyTableMsg& m) {
+       m.robot("other");
+       rechecksum(m);
+     },
+     PolicyReason::wrong_robot},
+    {"empty_id",
+     [](PolicyTableMsg& m) {
+       m.policy_id("");
+       rechecksum(m);
+     },
+     PolicyReason::bad_policy_id},
+    {"motors",
+     [](PolicyTableMsg& m) {
+       m.motor_count(3);
+       rechecksum(m);
+     },
+     PolicyReason::bad_motor_count},
+    {"complexity",
+     [](PolicyTableMsg& m) {
+       m.complexity(17);
+       rechecksum(m);
+     },
+     PolicyReason::bad_complexity},
+    {"size",
+     [](PolicyTableMsg& m) {
+       m.rest_length_m().pop_back();
+       rechecksum(m);
+     },
+     PolicyReason::bad_size},
     {"checksum", [](PolicyTableMsg& m) { m.checksum(m.checksum() ^ 1U); }, PolicyReason::bad_checksum},
-    {"nan", [](PolicyTableMsg& m) { m.rest_length_m()[2] = std::nan(""); rechecksum(m); },
+    {"nan",
+     [](PolicyTableMsg& m) {
+       m.rest_length_m()[2] = std::nan("");
+       rechecksum(m);
+     },
      PolicyReason::non_finite_value},
-    {"range", [](PolicyTableMsg& m) { m.rest_length_m()[2] = 5.0; rechecksum(m); },
+    {"range",
+     [](PolicyTableMsg& m) {
+       m.rest_length_m()[2] = 5.0;
+       rechecksum(m);
+     },
      PolicyReason::value_out_of_limits},
-    {"period", [](PolicyTableMsg& m) { m.period_s(-1.0); rechecksum(m); }, PolicyReason::bad_period},
-    {"phase", [](PolicyTableMsg& m) { m.phase_offset_s(std::numeric_limits<double>::infinity()); rechecksum(m); },
+    {"period",
+     [](PolicyTableMsg& m) {
+       m.period_s(-1.0);
+       rechecksum(m);
+     },
+     PolicyReason::bad_period},
+    {"phase",
+     [](PolicyTableMsg& m) {
+       m.phase_offset_s(std::numeric_limits<double>::infinity());
+       rechecksum(m);
+     },
      PolicyReason::bad_phase},
 };
 

@@ -71,9 +71,9 @@ TEST(TimeSyncClient, ImplausibleRepliesAreRefusedWithoutArithmeticOnBadStamps) {
   const std::int64_t t1 = 1000 * kMs;
   const Answer a = honest(t1);
   const std::uint64_t n = c.start_request(t1);
-  EXPECT_EQ(c.on_reply(n, a.t3, a.t2, a.t4), TimeSyncVerdict::implausible);                   // t3 < t2
+  EXPECT_EQ(c.on_reply(n, a.t3, a.t2, a.t4), TimeSyncVerdict::implausible);                        // t3 < t2
   EXPECT_EQ(c.on_reply(n, a.t2, a.t2 + 60 * kMs, a.t4 + 60 * kMs), TimeSyncVerdict::implausible);  // held 60 ms
-  EXPECT_EQ(c.on_reply(n, a.t2, a.t3, t1 + 600 * kMs), TimeSyncVerdict::implausible);        // round trip 0.6 s
+  EXPECT_EQ(c.on_reply(n, a.t2, a.t3, t1 + 600 * kMs), TimeSyncVerdict::implausible);              // round trip 0.6 s
   EXPECT_EQ(c.on_reply(n, std::numeric_limits<std::int64_t>::min(), a.t3, a.t4), TimeSyncVerdict::implausible);
   EXPECT_EQ(c.on_reply(n, a.t2, std::numeric_limits<std::int64_t>::max(), a.t4), TimeSyncVerdict::implausible);
   c.settle(t1 + 100 * kMs);

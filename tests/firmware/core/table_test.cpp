@@ -84,9 +84,7 @@ TEST(TableClock, NonIntegralSubintervalsCoverThePeriod) {
   EXPECT_EQ(changes, 6);
 }
 
-TEST(TableValidate, AcceptsAGoodTable) {
-  EXPECT_EQ(validate(make_table(5, 4.0), 2, MotorLimits{}), TableError::none);
-}
+TEST(TableValidate, AcceptsAGoodTable) { EXPECT_EQ(validate(make_table(5, 4.0), 2, MotorLimits{}), TableError::none); }
 
 TEST(TableValidate, RejectsEachBadField) {
   const MotorLimits limits{};

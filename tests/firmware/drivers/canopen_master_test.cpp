@@ -46,8 +46,7 @@ TEST(CanopenMaster, NmtStartMakesANodeOperational) {
   b.deliver();
   EXPECT_EQ(b.drive.nmt_state(), NmtState::operational);
   EXPECT_EQ(b.load_cell.nmt_state(), NmtState::pre_operational) << "addressed to the drive only";
-  ASSERT_TRUE(b.run_until(
-      [&] { return b.master.heartbeat(NodeRole::drive).state == NmtState::operational; }, 50));
+  ASSERT_TRUE(b.run_until([&] { return b.master.heartbeat(NodeRole::drive).state == NmtState::operational; }, 50));
 
   b.master.send_nmt(NmtCommand::reset_node, 0);
   b.deliver();
@@ -117,8 +116,8 @@ TEST(CanopenMaster, FaultIsReportedAndClearedOnlyByFaultReset) {
   EXPECT_EQ(b.master.drive().state, Cia402State::fault);
   auto events = b.take_events();
   ASSERT_TRUE(has_event(events, MasterEventKind::emcy, 3));
-  const auto emcy = std::find_if(events.begin(), events.end(),
-                                 [](const MasterEvent& e) { return e.kind == MasterEventKind::emcy; });
+  const auto emcy =
+      std::find_if(events.begin(), events.end(), [](const MasterEvent& e) { return e.kind == MasterEventKind::emcy; });
   EXPECT_EQ(emcy->emcy.error_code, 0x2310);
   EXPECT_EQ(emcy->emcy.error_register, kErrRegGeneric | kErrRegCurrent);
   EXPECT_STREQ(emcy_error_text(emcy->emcy.error_code), "continuous over-current");
@@ -260,13 +259,13 @@ TEST(CanopenMaster, MalformedAndForeignFramesAreCountedAndIgnored) {
   CanFrame rtr = encode_heartbeat(3, NmtState::operational);
   rtr.rtr = true;
   feed(rtr);
-  feed(encode_nmt(NmtCommand::stop, 3));               // another master's NMT
-  feed(encode_drive_rpdo1(3, {0x0000, 0}));            // an RPDO echoed back
-  feed(encode_drive_tpdo1(9, {0x0008, 1}));            // node 9 is not ours
+  feed(encode_nmt(NmtCommand::stop, 3));     // another master's NMT
+  feed(encode_drive_rpdo1(3, {0x0000, 0}));  // an RPDO echoed back
+  feed(encode_drive_tpdo1(9, {0x0008, 1}));  // node 9 is not ours
   CanFrame short_tpdo = encode_drive_tpdo1(3, {0x0008, 1});
   short_tpdo.dlc = 4;
   feed(short_tpdo);
-  feed(encode_drive_tpdo1(3, {0x0001, 1}));            // statusword matches no state
+  feed(encode_drive_tpdo1(3, {0x0001, 1}));  // statusword matches no state
   CanFrame hb_long = encode_heartbeat(3, NmtState::operational);
   hb_long.dlc = 2;
   feed(hb_long);
@@ -279,7 +278,7 @@ TEST(CanopenMaster, MalformedAndForeignFramesAreCountedAndIgnored) {
   CanFrame lc_reserved = encode_load_cell_tpdo1(4, {});
   lc_reserved.data[6] = 0x80;
   feed(lc_reserved);
-  feed(encode_drive_tpdo2(4, {}));                     // load cell has no TPDO2
+  feed(encode_drive_tpdo2(4, {}));                                     // load cell has no TPDO2
   feed(encode_sdo(3, {SdoKind::upload_response, {0x1000, 0}, 1, 4}));  // nothing pending
   CanFrame sync_long = encode_sync(1);
   sync_long.dlc = 2;

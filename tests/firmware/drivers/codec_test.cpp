@@ -135,15 +135,15 @@ TEST(SdoCodec, ExpeditedFramesRoundTrip) {
     std::uint8_t command_byte;
   };
   const SdoAddress a{0x6060, 0};
-  for (const Case& c : {Case{{SdoKind::download_request, a, 8, 1}, false, 0x2F},
-                        Case{{SdoKind::download_request, a, 0x1234, 2}, false, 0x2B},
-                        Case{{SdoKind::download_request, a, 0x123456, 3}, false, 0x27},
-                        Case{{SdoKind::download_request, a, 0xDEADBEEF, 4}, false, 0x23},
-                        Case{{SdoKind::download_response, a, 0, 0}, true, 0x60},
-                        Case{{SdoKind::upload_request, a, 0, 0}, false, 0x40},
-                        Case{{SdoKind::upload_response, a, 0xAB, 1}, true, 0x4F},
-                        Case{{SdoKind::upload_response, a, 0x00020192, 4}, true, 0x43},
-                        Case{{SdoKind::abort, a, sdo_abort::kNoObject, 4}, true, 0x80}}) {
+  for (const Case& c :
+       {Case{{SdoKind::download_request, a, 8, 1}, false, 0x2F},
+        Case{{SdoKind::download_request, a, 0x1234, 2}, false, 0x2B},
+        Case{{SdoKind::download_request, a, 0x123456, 3}, false, 0x27},
+        Case{{SdoKind::download_request, a, 0xDEADBEEF, 4}, false, 0x23},
+        Case{{SdoKind::download_response, a, 0, 0}, true, 0x60}, Case{{SdoKind::upload_request, a, 0, 0}, false, 0x40},
+        Case{{SdoKind::upload_response, a, 0xAB, 1}, true, 0x4F},
+        Case{{SdoKind::upload_response, a, 0x00020192, 4}, true, 0x43},
+        Case{{SdoKind::abort, a, sdo_abort::kNoObject, 4}, true, 0x80}}) {
     const CanFrame f = encode_sdo(5, c.m);
     EXPECT_EQ(f.id, c.from_server ? 0x585U : 0x605U);
     EXPECT_EQ(f.dlc, 8);

@@ -38,9 +38,12 @@ TEST(CanopenMasterHotPath, CycleDoesNotAllocate) {
   CanopenMaster master(bus, config);
   master.start_bring_up(0);
   const CanFrame frames[] = {
-      encode_heartbeat(1, NmtState::operational), encode_drive_tpdo1(1, {0x0627, 1000}),
-      encode_drive_tpdo2(1, {-20, 8}),            encode_load_cell_tpdo1(2, {{1000, 2000}, 3, 1}),
-      encode_emcy(1, {0x2310, 3, {}}),            encode_drive_tpdo1(7, {0x0627, 1000}),
+      encode_heartbeat(1, NmtState::operational),
+      encode_drive_tpdo1(1, {0x0627, 1000}),
+      encode_drive_tpdo2(1, {-20, 8}),
+      encode_load_cell_tpdo1(2, {{1000, 2000}, 3, 1}),
+      encode_emcy(1, {0x2310, 3, {}}),
+      encode_drive_tpdo1(7, {0x0627, 1000}),
       encode_sync(),
   };
   const std::size_t before = g_allocations.load();

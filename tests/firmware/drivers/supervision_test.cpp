@@ -176,9 +176,8 @@ TEST(CanopenSupervision, ARebootedDriveForgetsItsConsumerAndComesBackUnpowered) 
   EXPECT_EQ(b.drive.nmt_state(), NmtState::pre_operational);
   EXPECT_EQ(b.drive.consumer_time_ms(), 0) << "0x1016 back at its power-on value";
   const auto events = b.take_events();
-  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const MasterEvent& e) {
-    return e.kind == MasterEventKind::boot_up && e.node_id == 3;
-  }));
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(),
+                          [](const MasterEvent& e) { return e.kind == MasterEventKind::boot_up && e.node_id == 3; }));
   EXPECT_EQ(b.master.heartbeat(NodeRole::drive).boot_ups, boot_ups + 1);
 }
 

@@ -55,15 +55,14 @@ TEST(CanBusSpec, RejectsBadSpecsWithAReason) {
     const char* spec;
     const char* reason;
   };
-  for (const Case& c : {Case{"", "unknown CAN bus"}, Case{"tcp:1.2.3.4:5", "unknown CAN bus"},
-                        Case{"udp:", "expected HOST:PORT"}, Case{"udp:1.2.3.4", "expected HOST:PORT"},
-                        Case{"udp::7000", "missing host"}, Case{"udp:h:70000", "0..65535"},
-                        Case{"udp:h:x1", "0..65535"}, Case{"udp:h:0", "must not be 0"},
-                        Case{"udp:h:1,foo=1", "unknown option"}, Case{"udp:h:1,bind=h", "bind"},
-                        Case{"udp:h:1,batch,batch", "given twice"}, Case{"udp:h:1,bind=h:2,bind=h:3", "given twice"},
-                        Case{"udp:h:1,", "unknown option"}, Case{"udp:h:1,batch=1", "unknown option"},
-                        Case{"socketcan:", "interface name"},
-                        Case{"socketcan:a_very_long_interface_name", "interface name"}}) {
+  for (const Case& c :
+       {Case{"", "unknown CAN bus"}, Case{"tcp:1.2.3.4:5", "unknown CAN bus"}, Case{"udp:", "expected HOST:PORT"},
+        Case{"udp:1.2.3.4", "expected HOST:PORT"}, Case{"udp::7000", "missing host"}, Case{"udp:h:70000", "0..65535"},
+        Case{"udp:h:x1", "0..65535"}, Case{"udp:h:0", "must not be 0"}, Case{"udp:h:1,foo=1", "unknown option"},
+        Case{"udp:h:1,bind=h", "bind"}, Case{"udp:h:1,batch,batch", "given twice"},
+        Case{"udp:h:1,bind=h:2,bind=h:3", "given twice"}, Case{"udp:h:1,", "unknown option"},
+        Case{"udp:h:1,batch=1", "unknown option"}, Case{"socketcan:", "interface name"},
+        Case{"socketcan:a_very_long_interface_name", "interface name"}}) {
     CanBusSpec spec;
     std::string error;
     EXPECT_FALSE(parse_can_bus_spec(c.spec, spec, error)) << c.spec;

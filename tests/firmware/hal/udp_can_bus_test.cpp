@@ -53,8 +53,7 @@ class RawSender {
   }
   ~RawSender() { ::close(fd_); }
   void send(const std::vector<std::uint8_t>& bytes) {
-    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to_),
-                       sizeof(to_)),
+    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to_), sizeof(to_)),
               static_cast<ssize_t>(bytes.size()));
   }
 
@@ -142,8 +141,8 @@ TEST(UdpCanBus, MalformedDatagramsAreDroppedAndCountedByReason) {
   std::vector<std::uint8_t> reserved = good;
   reserved[7] = 1;
 
-  for (const auto* bytes : {&too_short, &too_long, &bad_magic, &bad_version, &dlc9, &id_too_big, &bad_flags,
-                            &reserved}) {
+  for (const auto* bytes :
+       {&too_short, &too_long, &bad_magic, &bad_version, &dlc9, &id_too_big, &bad_flags, &reserved}) {
     raw.send(*bytes);
   }
   raw.send({});  // empty datagram

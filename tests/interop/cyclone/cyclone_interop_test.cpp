@@ -108,12 +108,13 @@ TEST_F(CycloneInterop, PolicyUploadedByCycloneIsAcceptedAndTheAckReadByCyclone) 
   constexpr int kDomain = 162;
   start_endcaps(kDomain);
   std::string out;
-  ASSERT_EQ(run_peer({"--domain", std::to_string(kDomain), "--listen-s", "0.5", "--timeout-s", "20",
-                      "--upload-version", "7", "--upload-repeat", "20", "--bad-checksum-first"},
+  ASSERT_EQ(run_peer({"--domain", std::to_string(kDomain), "--listen-s", "0.5", "--timeout-s", "20", "--upload-version",
+                      "7", "--upload-repeat", "20", "--bad-checksum-first"},
                      out),
             0);
   expect_same_names_as_fast_dds(out);
-  const auto acks = lines(out, std::regex(R"(ACK endcap=(\d+) seq=\d+ accepted=(\d) reason=(\d+) text='([^']*)' active=(\S*) v(\d+))"));
+  const auto acks = lines(
+      out, std::regex(R"(ACK endcap=(\d+) seq=\d+ accepted=(\d) reason=(\d+) text='([^']*)' active=(\S*) v(\d+))"));
   ASSERT_EQ(acks.size(), 13U) << "one rejected table, then one per end cap";
   // The table with a wrong checksum: rejected with its reason, nothing active yet.
   EXPECT_EQ(acks[0][2], "0");

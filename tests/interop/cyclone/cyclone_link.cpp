@@ -8,9 +8,7 @@ namespace {
 
 using QosPtr = std::unique_ptr<dds_qos_t, decltype(&dds_delete_qos)>;
 
-std::string failed(const std::string& what, dds_return_t rc) {
-  return what + ": " + dds_strretcode(rc);
-}
+std::string failed(const std::string& what, dds_return_t rc) { return what + ": " + dds_strretcode(rc); }
 
 // msgs/qos_profiles.xml, profile by profile. Two settings have no Fast DDS
 // counterpart in that file but are what Fast DDS does anyway:
@@ -48,9 +46,9 @@ CycloneParticipant::CycloneParticipant(int domain) {
   if (domain < 0 || domain > 232) throw CycloneError("domain " + std::to_string(domain) + ": expected 0..232");
   participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
   if (participant_ < 0) {
-    throw CycloneError(failed("cannot create a Cyclone participant on domain " + std::to_string(domain) +
-                                  " (check CYCLONEDDS_URI)",
-                              participant_));
+    throw CycloneError(
+        failed("cannot create a Cyclone participant on domain " + std::to_string(domain) + " (check CYCLONEDDS_URI)",
+               participant_));
   }
 }
 

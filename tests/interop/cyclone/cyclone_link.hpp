@@ -25,13 +25,13 @@ using TelemetryC = tensegrity_msgs_msg_dds__Telemetry_;
 enum class Profile { durable_events, stream };
 
 struct CycloneTopic {
-  const char* name;  // "rt/" + ROS topic name, as msgs::k*Topic
+  const char* name;                          // "rt/" + ROS topic name, as msgs::k*Topic
   const dds_topic_descriptor_t* descriptor;  // its m_typename is the DDS type name
   Profile profile;
 };
 
-inline const CycloneTopic kPolicyTableTopic{"rt/tensegrity/policy_table",
-                                            &tensegrity_msgs_msg_dds__PolicyTable__desc, Profile::durable_events};
+inline const CycloneTopic kPolicyTableTopic{"rt/tensegrity/policy_table", &tensegrity_msgs_msg_dds__PolicyTable__desc,
+                                            Profile::durable_events};
 inline const CycloneTopic kPolicyAckTopic{"rt/tensegrity/policy_ack", &tensegrity_msgs_msg_dds__PolicyAck__desc,
                                           Profile::durable_events};
 inline const CycloneTopic kTelemetryTopic{"rt/tensegrity/telemetry", &tensegrity_msgs_msg_dds__Telemetry__desc,

@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   cli.add_option("--domain", domain, "DDS domain id")->required()->check(CLI::Range(0, 232));
   cli.add_option("--endcaps", endcaps, "End caps expected, e.g. 0-11 or 0,3,5-7")->capture_default_str();
   cli.add_option("--listen-s", listen_s, "Seconds of telemetry to count")->check(CLI::Range(0.1, 3600.0));
-  cli.add_option("--timeout-s", timeout_s, "Seconds to wait for telemetry, and for acks")->check(CLI::Range(0.1, 3600.0));
+  cli.add_option("--timeout-s", timeout_s, "Seconds to wait for telemetry, and for acks")
+      ->check(CLI::Range(0.1, 3600.0));
   cli.add_option("--upload-version", version, "Upload policy 'cyclone_peer' with this version (0: no upload)")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{0xFFFFFFFF}));
   cli.add_option("--upload-repeat", repeat, "Upload this many successive versions (latency statistics)")
@@ -121,9 +122,10 @@ int main(int argc, char** argv) {
         const auto k = static_cast<std::size_t>(std::ceil(p * static_cast<double>(latencies_ms.size())));
         return latencies_ms[std::min(latencies_ms.size(), std::max<std::size_t>(k, 1)) - 1];
       };
-      std::printf("MEASURE cyclone_upload endcaps=%d uploads=%zu first_write_to_last_ack_ms median=%.2f p99=%.2f "
-                  "max=%.2f\n",
-                  std::popcount(mask), latencies_ms.size(), at(0.5), at(0.99), latencies_ms.back());
+      std::printf(
+          "MEASURE cyclone_upload endcaps=%d uploads=%zu first_write_to_last_ack_ms median=%.2f p99=%.2f "
+          "max=%.2f\n",
+          std::popcount(mask), latencies_ms.size(), at(0.5), at(0.99), latencies_ms.back());
       if (!peer.wait_active(params, timeout_s)) {
         std::printf("RESULT fail: the end caps' telemetry does not report the uploaded policy as active\n");
         return 1;

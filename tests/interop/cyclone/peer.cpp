@@ -100,8 +100,8 @@ bool Peer::listen(double seconds) {
                 static_cast<unsigned long long>(stats_[e].lost - lost0[i]), unsigned{stats_[e].mode});
   }
   std::printf("MEASURE cyclone_telemetry total_hz=%.1f lowest_endcap_hz=%.1f lost=%llu refused=%llu over_s=%.2f\n",
-              total, lowest, static_cast<unsigned long long>(lost),
-              static_cast<unsigned long long>(stats_.refused()), dt);
+              total, lowest, static_cast<unsigned long long>(lost), static_cast<unsigned long long>(stats_.refused()),
+              dt);
   if (stats_.refused() > 0) std::printf("REFUSED last: %s\n", stats_.last_refusal().c_str());
   return lowest > 0.0 && stats_.refused() == 0;
 }
@@ -181,7 +181,8 @@ std::map<int, Peer::Ack> Peer::exchange(const std::map<int, PolicyTableOut*>& ta
   const std::int64_t deadline = now_ns() + to_ns(timeout_s);
   // Transient-local would deliver to a late reader too; waiting for a match
   // just keeps the first write from being a retry.
-  while (matched_readers(tables_) == 0 && now_ns() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (matched_readers(tables_) == 0 && now_ns() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   std::int64_t next_send = 0;
   while (got.size() < tables.size() && now_ns() < deadline) {
     if (now_ns() >= next_send) {
@@ -200,9 +201,9 @@ std::map<int, Peer::Ack> Peer::exchange(const std::map<int, PolicyTableOut*>& ta
       got[a.endcap_id] = Ack{a.accepted, a.reason};
       last_ack_ns_ = now_ns();
       if (quiet_ && a.accepted) continue;
-      std::printf("ACK endcap=%d seq=%u accepted=%d reason=%u text='%s' active=%s v%u checksum=0x%08x\n",
-                  a.endcap_id, a.upload_sequence, a.accepted ? 1 : 0, unsigned{a.reason}, a.reason_text,
-                  a.active_policy_id, a.active_policy_version, a.active_checksum);
+      std::printf("ACK endcap=%d seq=%u accepted=%d reason=%u text='%s' active=%s v%u checksum=0x%08x\n", a.endcap_id,
+                  a.upload_sequence, a.accepted ? 1 : 0, unsigned{a.reason}, a.reason_text, a.active_policy_id,
+                  a.active_policy_version, a.active_checksum);
     }
     acks_in_.clear();
   }

@@ -20,7 +20,7 @@ struct EndcapTelemetry {
   bool seen = false;
   std::int64_t first_ns = 0;  // steady clock at the first sample
   std::uint64_t samples = 0;
-  std::uint64_t lost = 0;     // missing sequence numbers
+  std::uint64_t lost = 0;  // missing sequence numbers
   std::uint32_t last_seq = 0;
   std::uint8_t mode = 0;
   std::string active_policy_id;

@@ -67,7 +67,9 @@ TEST(AverageLinkage, IdenticalSignalsClusterTogether) {
   EXPECT_EQ(labels[1], labels[7]);
   EXPECT_EQ(std::count(labels.begin(), labels.end(), labels[1]), 3);
   // They are leaves next to each other in the drawing order.
-  const auto pos = [&](int leaf) { return std::find(t.leaf_order.begin(), t.leaf_order.end(), leaf) - t.leaf_order.begin(); };
+  const auto pos = [&](int leaf) {
+    return std::find(t.leaf_order.begin(), t.leaf_order.end(), leaf) - t.leaf_order.begin();
+  };
   const auto lo = std::min({pos(1), pos(5), pos(7)});
   const auto hi = std::max({pos(1), pos(5), pos(7)});
   EXPECT_EQ(hi - lo, 2);

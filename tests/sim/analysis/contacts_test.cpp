@@ -14,7 +14,6 @@ namespace {
 
 constexpr double kRadius = 0.03;
 
-
 // End caps 0, 1, 2 rest on the ground for 1 s while 1 slides along x at 0.5 m/s;
 // then 0 lifts 5 cm and 3 comes down: the robot tips onto face (1, 2, 3) for 1 s.
 // Everything else is 0.5 m up.
@@ -41,8 +40,8 @@ struct Script {
 TEST(Contacts, FindsWhichEndCapsTouchAndTheirSlip) {
   const Script s;
   const Contacts c = detect_contacts(s.time_s, s.node_m, kRadius);
-  EXPECT_EQ(c.touched(), (std::vector<bool>{true, true, true, true, false, false, false, false, false, false,
-                                            false, false}));
+  EXPECT_EQ(c.touched(),
+            (std::vector<bool>{true, true, true, true, false, false, false, false, false, false, false, false}));
   EXPECT_EQ(c.touched_count(), 4);
   EXPECT_NEAR(c.share[0], 0.5, 1e-9);
   EXPECT_NEAR(c.share[2], 1.0, 1e-9);

@@ -30,8 +30,7 @@ class Checkpoints : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    root_ = fs::temp_directory_path() /
-            ("evolve_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    root_ = fs::temp_directory_path() / ("evolve_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::remove_all(root_);
     fs::create_directories(root_);
   }
@@ -199,8 +198,9 @@ TEST_F(Checkpoints, AnInconsistentCheckpointIsRejected) {
   // Each is complete JSON but not a state the run could have been in.
   EXPECT_THROW((void)parse_checkpoint(tampered([](auto& j) { j["generation"] = 3; }), "x"), CheckpointError);
   EXPECT_THROW((void)parse_checkpoint(tampered([](auto& j) { j["populations"][0].erase(0); }), "x"), CheckpointError);
-  EXPECT_THROW((void)parse_checkpoint(tampered([](auto& j) { j["populations"][1][2]["rest_lengths_m"][0] = 2.0; }), "x"),
-               CheckpointError);
+  EXPECT_THROW(
+      (void)parse_checkpoint(tampered([](auto& j) { j["populations"][1][2]["rest_lengths_m"][0] = 2.0; }), "x"),
+      CheckpointError);
   EXPECT_THROW((void)parse_checkpoint(tampered([](auto& j) { j["rng_state"] = "12 34"; }), "x"), CheckpointError);
   EXPECT_THROW((void)parse_checkpoint(tampered([](auto& j) { j.erase("curve"); }), "x"), CheckpointError);
   EXPECT_THROW((void)parse_checkpoint("not json", "x"), CheckpointError);

@@ -79,7 +79,8 @@ TEST(MpiWire, DamagedBytesAreRefused) {
   wire::Job job{1, 2, Team{{{0.7, 0.8}, {0.9}}}};
   const wire::Bytes good = wire::encode(job);
   for (std::size_t n = 0; n < good.size(); ++n) {
-    EXPECT_THROW((void)wire::decode_job(wire::Bytes(good.begin(), good.begin() + static_cast<long>(n))), wire::WireError)
+    EXPECT_THROW((void)wire::decode_job(wire::Bytes(good.begin(), good.begin() + static_cast<long>(n))),
+                 wire::WireError)
         << n << " bytes";
   }
   wire::Bytes longer = good;

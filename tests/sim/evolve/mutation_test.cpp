@@ -65,7 +65,7 @@ TEST(Mutation, AuthorLeavesHalfTheCopiesAndHalfTheValuesOfTheRest) {
 TEST(Mutation, AuthorStepIsThreePercentOfTheRange) {
   Coevolution evo(author_config());
   EXPECT_DOUBLE_EQ(evo.config().sigma_m, 0.015);  // 0.03 of 0.6-1.1 m
-  const Tally t = mutate_many(evo, 0.85);   // 0.25 m from a limit: 16 sigma, no clamping
+  const Tally t = mutate_many(evo, 0.85);         // 0.25 m from a limit: 16 sigma, no clamping
   const double sigma = std::sqrt(t.sum_sq_step / t.changed_values);
   // The sample sd of ~25,000 normals is within 2 % of sigma with overwhelming probability.
   EXPECT_NEAR(sigma, 0.015, 0.02 * 0.015);
