@@ -6,7 +6,10 @@
 #   tsan  ThreadSanitizer on the threads that share memory: the control loop's
 #         mailbox, the end cap's DDS node (end caps in comms_test_node processes
 #         against ground participants) and the HIL's UDP hub
-# Usage: scripts/sanitize.sh [asan] [tsan]   (default: both)
+#   ci    what CI runs (scripts/test.sh), about 4 minutes on 2 cores: asan on the
+#         firmware's unit tests (core, drivers, hal, app with its end-cap process
+#         tests, mailbox, comms), tsan on the mailbox
+# Usage: scripts/sanitize.sh [asan] [tsan] [ci]   (default: asan tsan)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
@@ -20,6 +23,18 @@ run_asan() {
     hil_unit_tests ground_cli_tests
   ctest --preset asan -L "^($unit)\$"
   ctest --preset asan -R 'RealEndcaps|EndcapProcess'
+}
+
+firmware='core_tests|test_drivers|test_hal|endcap_app_tests|mailbox_tests|comms_tests'
+
+run_ci() {
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j "$jobs" --target core_tests test_drivers test_hal endcap_app_tests mailbox_tests \
+    comms_tests
+  ctest --preset asan -L "^($firmware)\$"
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan -j "$jobs" --target mailbox_tests
+  ctest --preset tsan -L '^mailbox_tests$'
 }
 
 run_tsan() {

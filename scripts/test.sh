@@ -39,6 +39,11 @@ echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
 fuzz_start=$(date +%s)
 FUZZ_RUNS=5000 scripts/fuzz.sh
 echo "test: fuzzing took $(( $(date +%s) - fuzz_start )) s"
+# ASan + UBSan on the firmware's unit tests, TSan on the loop's mailbox (the subset
+# that fits CI's time; scripts/sanitize.sh asan tsan runs the wider sets).
+san_start=$(date +%s)
+scripts/sanitize.sh ci
+echo "test: sanitizers took $(( $(date +%s) - san_start )) s"
 for arch in ${TENSEGRITY_CROSS:-armhf}; do
   [[ "$arch" == none ]] && continue
   JOBS="$(nproc)" scripts/cross-test.sh "$arch"
