@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/app/json_reader.hpp"
 #include "firmware/core/table.hpp"
 #include "firmware/hal/can_bus_spec.hpp"
 
@@ -18,78 +19,14 @@ namespace {
 
 using json = nlohmann::json;
 
-// Reads one JSON object, remembering the source and the path for error text.
-class Reader {
- public:
-  Reader(const json& j, std::string source, std::string path)
-      : j_(j), source_(std::move(source)), path_(std::move(path)) {
-    if (!j_.is_object()) fail("", "must be an object");
-  }
+using Reader = JsonReader<ConfigError>;
 
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw ConfigError(source_ + ": " + field(key) + ": " + what);
+std::uint8_t node_id(const Reader& r, const json& v, const std::string& key) {
+  if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 127) {
+    r.fail(key, "must be a CANopen node id 1..127");
   }
-  std::string field(const std::string& key) const {
-    if (path_.empty()) return key.empty() ? "(top level)" : key;
-    return key.empty() ? path_ : path_ + "." + key;
-  }
-  void only(std::initializer_list<const char*> keys) const {
-    for (const auto& [k, v] : j_.items()) {
-      bool known = false;
-      for (const char* allowed : keys) known = known || k == allowed;
-      if (!known) fail(k, "unknown field");
-    }
-  }
-  bool has(const char* key) const { return j_.contains(key); }
-  const json& at(const char* key) const {
-    if (!j_.contains(key)) fail(key, "missing");
-    return j_.at(key);
-  }
-  Reader object(const char* key) const { return Reader(at(key), source_, field(key)); }
-  // An optional object: when absent, an empty one (its fields take their defaults).
-  Reader object_or_empty(const char* key) const {
-    static const json kEmpty = json::object();
-    return has(key) ? object(key) : Reader(kEmpty, source_, field(key));
-  }
-
-  double number(const char* key, double fallback, bool required = false) const {
-    if (!has(key)) {
-      if (required) fail(key, "missing");
-      return fallback;
-    }
-    const json& v = j_.at(key);
-    if (!v.is_number()) fail(key, "must be a number");
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) fail(key, "must be finite");
-    return x;
-  }
-  double positive(const char* key, double fallback, bool required = false) const {
-    const double x = number(key, fallback, required);
-    if (!(x > 0.0)) fail(key, "must be > 0");
-    return x;
-  }
-  std::string string(const char* key) const {
-    const json& v = at(key);
-    if (!v.is_string() || v.get<std::string>().empty()) fail(key, "must be a non-empty string");
-    return v.get<std::string>();
-  }
-  bool boolean(const char* key, bool fallback) const {
-    if (!has(key)) return fallback;
-    if (!j_.at(key).is_boolean()) fail(key, "must be true or false");
-    return j_.at(key).get<bool>();
-  }
-  std::uint8_t node_id(const json& v, const std::string& key) const {
-    if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 127) {
-      fail(key, "must be a CANopen node id 1..127");
-    }
-    return static_cast<std::uint8_t>(v.get<long long>());
-  }
-
- private:
-  const json& j_;
-  std::string source_;
-  std::string path_;
-};
+  return static_cast<std::uint8_t>(v.get<long long>());
+}
 
 // Whole milliseconds, 1..65535: what 0x1016 / 0x1017 can say.
 void check_whole_ms(const Reader& r, const char* key, double s) {
@@ -181,18 +118,18 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   std::set<int> seen;
   for (std::size_t i = 0; i < drives.size(); ++i) {
     const std::string key = "drives[" + std::to_string(i) + "]";
-    c.drive_node_ids[i] = nodes.node_id(drives[i], key);
+    c.drive_node_ids[i] = node_id(nodes, drives[i], key);
     if (!seen.insert(c.drive_node_ids[i]).second) nodes.fail(key, "node id used twice");
   }
   if (nodes.has("load_cell") && nodes.at("load_cell").is_null()) {
     c.use_load_cell = false;
   } else {
-    c.load_cell_node_id = nodes.node_id(nodes.at("load_cell"), "load_cell");
+    c.load_cell_node_id = node_id(nodes, nodes.at("load_cell"), "load_cell");
     if (!seen.insert(c.load_cell_node_id).second) nodes.fail("load_cell", "node id used by a drive too");
     if (c.motor_count > 2) nodes.fail("drives", "the load cell has two channels: at most two motors");
   }
   if (nodes.has("endcap")) {
-    c.endcap_node_id = nodes.node_id(nodes.at("endcap"), "endcap");
+    c.endcap_node_id = node_id(nodes, nodes.at("endcap"), "endcap");
     if (!seen.insert(c.endcap_node_id).second) nodes.fail("endcap", "node id used by a drive or the load cell too");
   } else if (!seen.insert(c.endcap_node_id).second) {
     nodes.fail("endcap", "the default end-cap node id 127 is taken: give another");

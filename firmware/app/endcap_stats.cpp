@@ -3,9 +3,10 @@
 
 #include <cstdio>
 #include <fstream>
-#include <type_traits>
 
 #include <nlohmann/json.hpp>
+
+#include "firmware/app/json_reader.hpp"
 
 namespace tensegrity::fw::app {
 namespace {
@@ -16,70 +17,10 @@ json timing_json(const TimingStats& t) {
   return {{"count", t.count}, {"p50_us", t.p50_us}, {"p99_us", t.p99_us}, {"max_us", t.max_us}};
 }
 
-// Field access that names the field (and where it sits) when it is missing or of
-// the wrong type, instead of nlohmann's "type must be number, but is null".
-class Fields {
- public:
-  Fields(const json& j, std::string source, std::string path)
-      : j_(j), source_(std::move(source)), path_(std::move(path)) {
-    if (!j_.is_object()) fail("", "must be an object");
-  }
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    const std::string field =
-        path_.empty() ? (key.empty() ? "(top level)" : key) : (key.empty() ? path_ : path_ + "." + key);
-    throw StatsError(source_ + ": " + field + ": " + what);
-  }
-  template <typename T>
-  T get(const char* key) const {
-    if (!j_.contains(key)) fail(key, "missing");
-    const json& v = j_.at(key);
-    if (!has_type<T>(v)) fail(key, std::string("must be ") + expected<T>());
-    try {
-      return v.get<T>();
-    } catch (const json::exception&) {  // out of T's range
-      fail(key, std::string("must be ") + expected<T>());
-    }
-  }
-  bool null_or_absent(const char* key) const { return !j_.contains(key) || j_.at(key).is_null(); }
-  Fields object(const char* key) const {
-    if (!j_.contains(key)) fail(key, "missing");
-    return Fields(j_.at(key), source_, path_.empty() ? key : path_ + "." + key);
-  }
-
- private:
-  // nlohmann converts -1 to a uint64_t and 2.5 to an int without a word.
-  template <typename T>
-  static bool has_type(const json& v) {
-    if constexpr (std::is_same_v<T, bool>)
-      return v.is_boolean();
-    else if constexpr (std::is_same_v<T, std::string>)
-      return v.is_string();
-    else if constexpr (std::is_unsigned_v<T>)
-      return v.is_number_unsigned();
-    else if constexpr (std::is_integral_v<T>)
-      return v.is_number_integer();
-    else
-      return v.is_number();
-  }
-  template <typename T>
-  static const char* expected() {
-    if constexpr (std::is_same_v<T, bool>)
-      return "true or false";
-    else if constexpr (std::is_same_v<T, std::string>)
-      return "a string";
-    else if constexpr (std::is_unsigned_v<T>)
-      return "a count (an integer >= 0)";
-    else if constexpr (std::is_integral_v<T>)
-      return "an integer";
-    else
-      return "a number";
-  }
-  const json& j_;
-  std::string source_, path_;
-};
+using Fields = JsonReader<StatsError>;
 
 TimingStats parse_timing(const Fields& f) {
-  return {f.get<std::uint64_t>("count"), f.get<double>("p50_us"), f.get<double>("p99_us"), f.get<double>("max_us")};
+  return {f.count("count"), f.number("p50_us"), f.number("p99_us"), f.number("max_us")};
 }
 
 }  // namespace
@@ -123,35 +64,34 @@ json to_json(const EndcapStats& s) {
 
 EndcapStats parse_stats(const json& j, const std::string& source) {
   const Fields f(j, source, "");
-  if (f.get<std::string>("format") != EndcapStats::kFormat) {
+  if (f.string("format") != EndcapStats::kFormat) {
     f.fail("format", std::string("expected \"") + EndcapStats::kFormat + "\"");
   }
   EndcapStats s;
-  s.final = f.get<bool>("final");
-  s.endcap = f.get<int>("endcap");
-  s.mode = f.get<std::string>("mode");
-  s.rate_hz = f.get<double>("rate_hz");
-  s.cycles = f.get<std::uint64_t>("cycles");
-  s.overruns = f.get<std::uint64_t>("overruns");
-  s.stalls = f.get<std::uint64_t>("stalls");
-  s.late_wakeups = f.get<std::uint64_t>("late_wakeups");
-  s.syncs_received = f.get<std::uint64_t>("syncs_received");
-  s.send_failures = f.get<std::uint64_t>("send_failures");
-  s.rx_drops = f.get<std::uint64_t>("rx_drops");
-  s.drain_limited_cycles = f.get<std::uint64_t>("drain_limited_cycles");
-  s.fault = f.get<std::string>("fault");
-  s.bring_up = f.get<std::string>("bring_up");
-  s.vm_rss_kb = f.get<long>("vm_rss_kb");
+  s.final = f.boolean("final");
+  s.endcap = static_cast<int>(f.integer("endcap"));
+  s.mode = f.string("mode");
+  s.rate_hz = f.number("rate_hz");
+  s.cycles = f.count("cycles");
+  s.overruns = f.count("overruns");
+  s.stalls = f.count("stalls");
+  s.late_wakeups = f.count("late_wakeups");
+  s.syncs_received = f.count("syncs_received");
+  s.send_failures = f.count("send_failures");
+  s.rx_drops = f.count("rx_drops");
+  s.drain_limited_cycles = f.count("drain_limited_cycles");
+  s.fault = f.string("fault");
+  s.bring_up = f.string("bring_up", true);
+  s.vm_rss_kb = static_cast<long>(f.integer("vm_rss_kb"));
   const Fields link = f.object("link");
-  s.link = {link.get<std::uint64_t>("host_losses"), link.get<std::uint64_t>("host_returns"),
-            link.get<std::uint64_t>("link_cuts"), link.get<std::uint64_t>("loop_stalls")};
+  s.link = {link.count("host_losses"), link.count("host_returns"), link.count("link_cuts"), link.count("loop_stalls")};
   if (!f.null_or_absent("cycle")) s.cycle = parse_timing(f.object("cycle"));
   if (!f.null_or_absent("wakeup_latency")) s.wakeup_latency = parse_timing(f.object("wakeup_latency"));
   if (!f.null_or_absent("table")) {
     const Fields t = f.object("table");
-    TablePhase p{t.get<double>("period_s"), t.get<std::int64_t>("loop_time_ns"), t.get<std::int64_t>("table_time_ns"),
-                 t.get<std::int64_t>("origin_loop_ns"), std::nullopt};
-    if (!t.null_or_absent("loop_clock_origin_ns")) p.loop_clock_origin_ns = t.get<std::int64_t>("loop_clock_origin_ns");
+    TablePhase p{t.number("period_s"), t.integer("loop_time_ns"), t.integer("table_time_ns"),
+                 t.integer("origin_loop_ns"), std::nullopt};
+    if (!t.null_or_absent("loop_clock_origin_ns")) p.loop_clock_origin_ns = t.integer("loop_clock_origin_ns");
     if (!(p.period_s > 0.0)) t.fail("period_s", "must be > 0");
     s.table = p;
   }
