@@ -11,6 +11,7 @@
 #include <ctime>
 #include <limits>
 
+#include "firmware/core/table.hpp"
 #include "ground/command.hpp"
 #include "ground/keystore.hpp"
 #include "ground/station.hpp"
@@ -27,7 +28,8 @@ namespace {
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
 
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+// Seconds from a config to nanoseconds: the one rounding conversion, core's.
+std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 
 // Threads of this provisioner talk DDS; they must not inherit the emulator's
 // SCHED_FIFO (they would compete with the stepper they wait for).

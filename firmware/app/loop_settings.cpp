@@ -5,10 +5,12 @@
 #include <cmath>
 
 #include "firmware/app/control_loop.hpp"
+#include "firmware/core/table.hpp"
 
 namespace tensegrity::fw::app {
 namespace {
-std::int64_t to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+// Seconds from a config to nanoseconds: the one rounding conversion, core's.
+std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 }  // namespace
 
 LoopSettings make_loop_settings(const EndcapAppConfig& c) {

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "firmware/comms/node_dds.hpp"
+#include "firmware/core/table.hpp"
 #include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
@@ -29,7 +30,8 @@ constexpr std::int64_t kInitialSyncSpacingNs = 25'000'000;
 // While unsynchronized the log says why, this often (a start is refused until then).
 constexpr std::int64_t kUnsyncedReportNs = 5'000'000'000;
 std::int64_t period_ns(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
-std::int64_t to_ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
+// Seconds from a config to nanoseconds: the one rounding conversion, core's.
+std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 }  // namespace
 
 EndcapNode::EndcapNode(const EndcapNodeConfig& config, Clock& clock, app::PolicyStore* store)

@@ -6,6 +6,7 @@
 
 #include "firmware/comms/endcap_node.hpp"
 #include "firmware/comms/node_dds.hpp"
+#include "firmware/core/table.hpp"
 #include "tensegrity_msgs/msg/PolicyAck.h"
 
 namespace tensegrity::fw::comms {
@@ -13,7 +14,8 @@ namespace tensegrity::fw::comms {
 namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
-std::int64_t to_ns(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
+// Seconds from a config to nanoseconds: the one rounding conversion, core's.
+std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 }  // namespace
 
 void EndcapNode::handle_tables(std::int64_t now) {
