@@ -265,6 +265,48 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   }
 }
 
+// The mutation operator and its step's schedule.
+void add_mutation_options(CLI::App& cmd, EvolveArgs& args) {
+  cmd.add_option("--mutation", args.mutation,
+                 "Mutation operator: gaussian (every value of a copy) or author (NTRT's: half the copies, half "
+                 "their values)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"author", "gaussian"}));
+  cmd.add_option("--sigma", args.sigma_m,
+                 "Mutation step, metres, clamped to the limits (default: 0.05 for gaussian, 0.03 of the "
+                 "rest-length range for author)")
+      ->check(CLI::Range(0.0, 10.0));
+  // The schedule's three options go together: a step given without its episodes
+  // (or the reverse) would be silently ignored.
+  CLI::Option* sigma_final = cmd.add_option("--sigma-final", args.sigma_final_m,
+                                            "Mutation step after --anneal-episodes, metres (default: no annealing)")
+                                 ->check(CLI::Range(0.0, 10.0));
+  CLI::Option* anneal = cmd.add_option("--anneal-episodes", args.anneal_episodes,
+                                       "Episodes over which the step goes geometrically from --sigma to --sigma-final")
+                            ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
+  CLI::Option* anneal_start = cmd.add_option("--anneal-start", args.anneal_start_episodes,
+                                             "Episodes at the constant --sigma before annealing begins (default 0)")
+                                  ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
+  sigma_final->needs(anneal);
+  anneal->needs(sigma_final);
+  anneal_start->needs(anneal);
+}
+
+// --mpi and what it needs.
+void add_mpi_options(CLI::App& cmd, EvolveArgs& args) {
+  cmd.add_flag("--mpi", args.mpi,
+               "Evaluate on the ranks of an MPI job (mpirun -np N tensegrity evolve ... --mpi): rank 0 evolves, "
+               "the others only evaluate; results do not depend on it");
+  cmd.add_option("--mpi-root-threads", args.mpi_root_threads,
+                 "With --mpi: rank 0's evaluating threads (default: --threads; 0: rank 0 only hands out teams)")
+      ->check(CLI::Range(0, 1024));
+  cmd.add_option("--mpi-timeout", args.mpi_timeout_s,
+                 "With --mpi: fail the run when a rank holding a team answers nothing for this many seconds "
+                 "(0: wait forever)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e7));
+}
+
 }  // namespace
 
 void add_evolve_command(CLI::App& app) {
@@ -302,46 +344,14 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--replace", args->replace, "Worst members replaced per generation")
       ->capture_default_str()
       ->check(CLI::Range(1, 50000));
-  cmd->add_option("--mutation", args->mutation,
-                  "Mutation operator: gaussian (every value of a copy) or author (NTRT's: half the copies, half "
-                  "their values)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"author", "gaussian"}));
-  cmd->add_option("--sigma", args->sigma_m,
-                  "Mutation step, metres, clamped to the limits (default: 0.05 for gaussian, 0.03 of the "
-                  "rest-length range for author)")
-      ->check(CLI::Range(0.0, 10.0));
-  // The schedule's three options go together: a step given without its episodes
-  // (or the reverse) would be silently ignored.
-  CLI::Option* sigma_final = cmd->add_option("--sigma-final", args->sigma_final_m,
-                                             "Mutation step after --anneal-episodes, metres (default: no annealing)")
-                                 ->check(CLI::Range(0.0, 10.0));
-  CLI::Option* anneal = cmd->add_option("--anneal-episodes", args->anneal_episodes,
-                                        "Episodes over which the step goes geometrically from --sigma to --sigma-final")
-                            ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
-  CLI::Option* anneal_start = cmd->add_option("--anneal-start", args->anneal_start_episodes,
-                                              "Episodes at the constant --sigma before annealing begins (default 0)")
-                                  ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
-  sigma_final->needs(anneal);
-  anneal->needs(sigma_final);
-  anneal_start->needs(anneal);
+  add_mutation_options(*cmd, *args);
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");
-  cmd->add_flag("--mpi", args->mpi,
-                "Evaluate on the ranks of an MPI job (mpirun -np N tensegrity evolve ... --mpi): rank 0 evolves, "
-                "the others only evaluate; results do not depend on it");
-  cmd->add_option("--mpi-root-threads", args->mpi_root_threads,
-                  "With --mpi: rank 0's evaluating threads (default: --threads; 0: rank 0 only hands out teams)")
-      ->check(CLI::Range(0, 1024));
-  cmd->add_option("--mpi-timeout", args->mpi_timeout_s,
-                  "With --mpi: fail the run when a rank holding a team answers nothing for this many seconds "
-                  "(0: wait forever)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e7));
+  add_mpi_options(*cmd, *args);
   cmd->callback([args] {
     if (args->resume && args->checkpoint.empty()) throw CommandError(2, "--resume needs --checkpoint DIR");
     check_evolve_launch(args->mpi);
