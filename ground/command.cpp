@@ -32,6 +32,22 @@ std::vector<int> CommandReport::missing() const {
   return out;
 }
 
+namespace {
+// A report with a row per addressed end cap, none acknowledged yet.
+CommandReport unanswered(CommandKind kind, std::int64_t start_host_time_ns, std::uint16_t endcap_mask) {
+  CommandReport report;
+  report.kind = kind;
+  report.start_host_time_ns = start_host_time_ns;
+  for (int e = 0; e < kEndcapCount; ++e) {
+    if ((endcap_mask & (1U << e)) == 0) continue;
+    EndcapCommandResult r;
+    r.endcap = e;
+    report.results.push_back(r);
+  }
+  return report;
+}
+}  // namespace
+
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
                            const CommandOptions& options) {
   if (options.endcap_mask == 0 || (options.endcap_mask & ~kAllEndcaps) != 0) {
@@ -50,15 +66,7 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
   const std::int64_t start = Station::now_ns();
   cmd.issued_host_time_ns(start);
 
-  CommandReport report;
-  report.kind = kind;
-  report.start_host_time_ns = start_host_time_ns;
-  for (int e = 0; e < kEndcapCount; ++e) {
-    if ((options.endcap_mask & (1U << e)) == 0) continue;
-    EndcapCommandResult r;
-    r.endcap = e;
-    report.results.push_back(r);
-  }
+  CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
   station.take_command_acks();
   const std::int64_t deadline = start + static_cast<std::int64_t>(options.timeout_s * 1e9);
   const auto retry_ns = static_cast<std::int64_t>(options.retry_interval_s * 1e9);
@@ -97,15 +105,7 @@ CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandK
   }
   const std::int64_t start = Station::now_ns();
   const std::int64_t deadline = start + static_cast<std::int64_t>(options.timeout_s * 1e9);
-  CommandReport report;
-  report.kind = kind;
-  report.start_host_time_ns = start_host_time_ns;
-  for (int e = 0; e < kEndcapCount; ++e) {
-    if ((options.endcap_mask & (1U << e)) == 0) continue;
-    EndcapCommandResult r;
-    r.endcap = e;
-    report.results.push_back(r);
-  }
+  CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
   std::uint16_t missing = options.endcap_mask;
   for (;;) {
     // One slice: until the missing end caps acked, the deadline, or stall_s passed.
