@@ -139,6 +139,8 @@ sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveC
   policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
   policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
   policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
+  policy.provenance.min_strut_gap_m = gait.min_strut_gap_m;
+  policy.provenance.strut_overlap_s = gait.strut_overlap_s;
   return gait;
 }
 
@@ -173,7 +175,9 @@ void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
                       {"gait",
                        {{"axial_spin_rms_rad_per_s", o.gait.axial_spin_rms_rad_per_s},
                         {"axial_spin_max_rad_per_s", o.gait.axial_spin_max_rad_per_s},
-                        {"endcaps_touched_ground", o.gait.endcaps_touched_ground}}}};
+                        {"endcaps_touched_ground", o.gait.endcaps_touched_ground},
+                        {"min_strut_gap_m", o.gait.min_strut_gap_m},
+                        {"strut_overlap_s", o.gait.strut_overlap_s}}}};
   if (mpi != nullptr) j["rank_loads"] = mpi->loads();
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -192,6 +196,8 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
   std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
   std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
               o.gait.axial_spin_rms_rad_per_s, o.gait.axial_spin_max_rad_per_s, o.gait.endcaps_touched_ground);
+  std::printf("  struts     %.3f m apart at the closest, overlapping for %.2f s\n", o.gait.min_strut_gap_m,
+              o.gait.strut_overlap_s);
   std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", o.wall_s, rate, o.threads);
   if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
   std::printf("\n");

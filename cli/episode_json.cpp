@@ -27,6 +27,8 @@ nlohmann::json episode_json(const sim::EpisodeResult& r) {
       {"axial_spin_rms_rad_per_s", r.axial_spin_rms_rad_per_s},
       {"axial_spin_max_rad_per_s", r.axial_spin_max_rad_per_s},
       {"endcaps_touched_ground", r.endcaps_touched_ground},
+      {"min_strut_gap_m", r.min_strut_gap_m},
+      {"strut_overlap_s", r.strut_overlap_s},
       {"steps", r.steps},
       {"sim_time_s", r.sim_time_s},
       {"wall_time_s", r.wall_time_s},
@@ -45,6 +47,8 @@ void print_episode_summary(const sim::EpisodeResult& r) {
   std::printf("  motors         %.1f J, %.2f W per cable on average\n", r.motor_energy_j, r.mean_motor_power_w);
   std::printf("  strut spin     %.2f rad/s RMS, %.2f max about their axes; %d end caps touched the ground\n",
               r.axial_spin_rms_rad_per_s, r.axial_spin_max_rad_per_s, r.endcaps_touched_ground);
+  std::printf("  strut gap      %.3f m at the closest; struts overlapped for %.2f s\n", r.min_strut_gap_m,
+              r.strut_overlap_s);
   std::printf("  time           %.2f s simulated in %.3f s wall (%.0fx real time)\n", r.sim_time_s, r.wall_time_s,
               r.real_time_factor());
 }

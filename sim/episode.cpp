@@ -6,10 +6,14 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace tensegrity::sim {
 namespace {
@@ -82,10 +86,68 @@ const ModelState& settled_state(const Robot& robot, double dt_s) {
   return *slot;
 }
 
-EpisodeResult run_episode(const Robot& robot, Controller& controller, const EpisodeOptions& options) {
-  const double dt = resolve_dt(robot, options.dt_s);
-  const auto wall_start = std::chrono::steady_clock::now();
-  Model model(robot, dt);
+namespace {
+
+// What an episode adds up step by step, apart from the stepping itself.
+class Tally {
+ public:
+  Tally(const Robot& robot, const Model& model)
+      : struts_(static_cast<int>(robot.struts.size())),
+        last_tension_(model.tension_n().begin(), model.tension_n().end()) {}
+
+  // One step's tensions, spin, contacts and strut gaps; `dt` is the step.
+  void add(const Model& model, double dt, EpisodeResult& result) {
+    for (int s = 0; s < struts_; ++s) {
+      const double w = model.axial_spin_rad_per_s(s);
+      spin_sq_sum_ += w * w;
+      result.axial_spin_max_rad_per_s = std::max(result.axial_spin_max_rad_per_s, std::abs(w));
+    }
+    touched_ |= model.ground_contact_mask();
+    const double gap = model.min_strut_gap_m();
+    min_gap_m_ = std::min(min_gap_m_, gap);
+    if (gap < 0.0) result.strut_overlap_s += dt;
+    const auto tension = model.tension_n();
+    const auto rate = model.rest_length_rate_m_per_s();
+    step_max_n_ = 0.0;
+    for (std::size_t m = 0; m < tension.size(); ++m) {
+      const double t = tension[m];
+      tension_sum_ += t;
+      if (t > step_max_n_) {
+        step_max_n_ = t;
+        worst_cable_ = m;
+      }
+      if (rate[m] < 0.0) result.motor_energy_j -= t * rate[m] * dt;
+      last_tension_[m] = t;
+    }
+    result.max_tension_n = std::max(result.max_tension_n, step_max_n_);
+  }
+
+  void finish(std::int64_t steps, EpisodeResult& result) const {
+    if (steps == 0) return;
+    const auto cables = static_cast<double>(last_tension_.size());
+    result.mean_tension_n = tension_sum_ / (static_cast<double>(steps) * cables);
+    result.mean_motor_power_w = result.motor_energy_j / (result.sim_time_s * cables);
+    result.axial_spin_rms_rad_per_s = std::sqrt(spin_sq_sum_ / (static_cast<double>(steps) * std::max(1, struts_)));
+    result.endcaps_touched_ground = std::popcount(touched_);
+    result.min_strut_gap_m = min_gap_m_;
+  }
+
+  const std::vector<double>& last_tension() const { return last_tension_; }
+  double step_max_n() const { return step_max_n_; }
+  std::size_t worst_cable() const { return worst_cable_; }
+
+ private:
+  int struts_;
+  std::vector<double> last_tension_;
+  double tension_sum_ = 0.0;
+  double spin_sq_sum_ = 0.0;
+  double min_gap_m_ = std::numeric_limits<double>::infinity();
+  std::uint32_t touched_ = 0;
+  double step_max_n_ = 0.0;
+  std::size_t worst_cable_ = 0;
+};
+
+void start_model(Model& model, const Robot& robot, double dt, const EpisodeOptions& options) {
   if (options.start_state != nullptr) {
     model.restore(*options.start_state);
   } else if (options.start == StartKind::settled) {
@@ -93,83 +155,66 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
   } else {
     model.restore(drop_state(robot, dt));
   }
+}
+
+void mark_infeasible(EpisodeResult& result, std::string why, double time_s) {
+  result.feasible = false;
+  result.infeasible_reason = std::move(why);
+  result.infeasible_time_s = time_s;
+}
+
+}  // namespace
+
+EpisodeResult run_episode(const Robot& robot, Controller& controller, const EpisodeOptions& options) {
+  const double dt = resolve_dt(robot, options.dt_s);
+  const auto wall_start = std::chrono::steady_clock::now();
+  Model model(robot, dt);
+  start_model(model, robot, dt, options);
   controller.reset(robot);
   if (options.telemetry != nullptr) options.telemetry->begin(model);
 
-  const std::size_t cables = robot.cables.size();
   std::vector<double> preferred(model.rest_length_m().begin(), model.rest_length_m().end());
-  std::vector<double> last_tension(model.tension_n().begin(), model.tension_n().end());
   const Eigen::Vector2d start = horizontal(model.centre_m());
   const auto steps = static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   const double hard_limit = robot.motor.hard_limit_tension_n;
   const int every = std::max(1, options.telemetry_every);
 
   EpisodeResult result;
-  double tension_sum = 0.0;
-  double spin_sq_sum = 0.0;
-  std::uint32_t touched = 0;
-  const int struts = static_cast<int>(robot.struts.size());
+  Tally tally(robot, model);
   std::int64_t done = 0;
   for (std::int64_t k = 0; k < steps; ++k) {
     ControlInput input;
     input.step = k;
     input.time_s = static_cast<double>(k) * dt;
     input.dt_s = dt;
-    input.tension_n = last_tension;
+    input.tension_n = tally.last_tension();
     input.rest_length_m = model.rest_length_m();
     controller.update(input, preferred);
     try {
       model.step(preferred);
     } catch (const ModelDiverged& e) {
-      result.feasible = false;
-      result.infeasible_reason = std::string("the model diverged: ") + e.what();
-      result.infeasible_time_s = static_cast<double>(k) * dt;
+      mark_infeasible(result, std::string("the model diverged: ") + e.what(), input.time_s);
       break;
     }
     ++done;
     if (model.diverged()) {
-      result.feasible = false;
-      result.infeasible_reason = "the model diverged (non-finite or runaway state)";
-      result.infeasible_time_s = static_cast<double>(k) * dt;
+      mark_infeasible(result, "the model diverged (non-finite or runaway state)", input.time_s);
       break;
     }
-
-    for (int s = 0; s < struts; ++s) {
-      const double w = model.axial_spin_rad_per_s(s);
-      spin_sq_sum += w * w;
-      result.axial_spin_max_rad_per_s = std::max(result.axial_spin_max_rad_per_s, std::abs(w));
-    }
-    touched |= model.ground_contact_mask();
-    const auto tension = model.tension_n();
-    const auto rate = model.rest_length_rate_m_per_s();
-    double step_max = 0.0;
-    std::size_t worst = 0;
-    for (std::size_t m = 0; m < cables; ++m) {
-      const double t = tension[m];
-      tension_sum += t;
-      if (t > step_max) {
-        step_max = t;
-        worst = m;
-      }
-      if (rate[m] < 0.0) result.motor_energy_j -= t * rate[m] * dt;
-      last_tension[m] = t;
-    }
-    result.max_tension_n = std::max(result.max_tension_n, step_max);
+    tally.add(model, dt, result);
     const double now = static_cast<double>(k + 1) * dt;
     if (options.telemetry != nullptr && (k + 1) % every == 0) options.telemetry->record(now, model);
+    const double step_max = tally.step_max_n();
     if (step_max > hard_limit || !std::isfinite(step_max)) {
       std::ostringstream why;
-      why << "cable " << worst << " tension " << step_max << " N above the hard limit " << hard_limit << " N";
-      result.feasible = false;
-      result.infeasible_reason = why.str();
-      result.infeasible_time_s = now;
+      why << "cable " << tally.worst_cable() << " tension " << step_max << " N above the hard limit " << hard_limit
+          << " N";
+      mark_infeasible(result, why.str(), now);
       break;
     }
   }
   if (result.feasible && !model.state_finite()) {
-    result.feasible = false;
-    result.infeasible_reason = "state not finite (the model diverged)";
-    result.infeasible_time_s = static_cast<double>(done) * dt;
+    mark_infeasible(result, "state not finite (the model diverged)", static_cast<double>(done) * dt);
   }
   if (options.telemetry != nullptr) options.telemetry->end();
 
@@ -179,12 +224,7 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
     result.displacement_m = horizontal(model.centre_m()) - start;
     result.distance_m = result.displacement_m.norm();
   }
-  if (done > 0) {
-    result.mean_tension_n = tension_sum / (static_cast<double>(done) * static_cast<double>(cables));
-    result.mean_motor_power_w = result.motor_energy_j / (result.sim_time_s * static_cast<double>(cables));
-    result.axial_spin_rms_rad_per_s = std::sqrt(spin_sq_sum / (static_cast<double>(done) * std::max(1, struts)));
-    result.endcaps_touched_ground = std::popcount(touched);
-  }
+  tally.finish(done, result);
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return result;
 }

@@ -42,6 +42,11 @@ struct EpisodeResult {
   double axial_spin_rms_rad_per_s = 0.0;
   double axial_spin_max_rad_per_s = 0.0;
   int endcaps_touched_ground = 0;  // of the robot's end caps, at any step
+  // How close two struts came: the smallest gap between their capsules' surfaces
+  // (negative: they overlapped, which without strut.rod_contact they may), and for
+  // how long any two overlapped.
+  double min_strut_gap_m = 0.0;
+  double strut_overlap_s = 0.0;
   double sim_time_s = 0.0;
   double wall_time_s = 0.0;
   std::int64_t steps = 0;

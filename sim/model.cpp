@@ -299,6 +299,8 @@ void Model::step(std::span<const double> preferred_rest_length_m) {
     return;
   }
   add_ground_contacts();
+  strut_contact_count_ = 0;
+  add_strut_contacts();
   dWorldStep(ode_->world, dt_s_);
   dJointGroupEmpty(ode_->contacts);
 }

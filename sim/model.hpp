@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The robot in ODE: struts as capsule bodies, cables as one-sided spring-dampers
-// between strut end points whose rest lengths motors drive, a ground plane.
+// between strut end points whose rest lengths motors drive, a ground plane, and
+// (robot.rod_contact) capsules that collide with each other.
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -69,6 +71,11 @@ class Model {
   int contact_count() const { return contact_count_; }
   // End caps in contact with the ground in the last step, bit `node` set.
   std::uint32_t ground_contact_mask() const { return ground_mask_; }
+  // The closest approach of two struts' surfaces in the last step, m: negative when
+  // two capsules overlap (measured whether or not the robot has rod contact).
+  double min_strut_gap_m() const { return min_strut_gap_m_; }
+  // Strut-strut contact joints made in the last step (robot.rod_contact only).
+  int strut_contact_count() const { return strut_contact_count_; }
 
   // Switches for the energy-conservation test; defaults follow the robot.
   void set_gravity_enabled(bool on);
@@ -80,6 +87,7 @@ class Model {
   void update_cable_geometry();
   void apply_forces();
   void add_ground_contacts();
+  void add_strut_contacts();  // model_strut_contact.cpp
   // Surface attachment: body-frame offsets of every cable end from its end cap centre.
   void init_surface_attachments();
   bool forces_sane() const;
@@ -107,6 +115,8 @@ class Model {
   bool ground_enabled_ = true;
   bool damping_enabled_ = true;
   int contact_count_ = 0;
+  int strut_contact_count_ = 0;
+  double min_strut_gap_m_ = std::numeric_limits<double>::infinity();
   bool diverged_ = false;
 };
 

@@ -49,6 +49,14 @@ void read_gait(const json& provenance, const Robot& robot, const std::string& so
     fail(source, "provenance.gait.endcaps_touched_ground", "must be within 0.." + std::to_string(robot.node_count()));
   }
   pr.endcaps_touched_ground = static_cast<int>(touched);
+  if (g->contains("min_strut_gap_m")) {
+    pr.min_strut_gap_m = finite_number(g->at("min_strut_gap_m"), source, "provenance.gait.min_strut_gap_m");
+  }
+  if (g->contains("strut_overlap_s")) {
+    const double s = finite_number(g->at("strut_overlap_s"), source, "provenance.gait.strut_overlap_s");
+    if (s < 0.0) fail(source, "provenance.gait.strut_overlap_s", "must be >= 0");
+    pr.strut_overlap_s = s;
+  }
 }
 
 }  // namespace
@@ -210,6 +218,8 @@ std::string policy_to_json(const Policy& policy) {
     doc["provenance"]["gait"] = {{"axial_spin_rms_rad_per_s", pr.axial_spin_rms_rad_per_s},
                                  {"axial_spin_max_rad_per_s", pr.axial_spin_max_rad_per_s},
                                  {"endcaps_touched_ground", pr.endcaps_touched_ground}};
+    if (pr.min_strut_gap_m) doc["provenance"]["gait"]["min_strut_gap_m"] = *pr.min_strut_gap_m;
+    if (pr.strut_overlap_s) doc["provenance"]["gait"]["strut_overlap_s"] = *pr.strut_overlap_s;
   }
   return doc.dump(2) + "\n";
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,10 @@ struct Provenance {
   double axial_spin_rms_rad_per_s = 0.0;
   double axial_spin_max_rad_per_s = 0.0;
   int endcaps_touched_ground = -1;
+  // The closest two struts came, m (negative: they overlapped), and how long two
+  // overlapped, s; absent in policies written before they were recorded.
+  std::optional<double> min_strut_gap_m = std::nullopt;
+  std::optional<double> strut_overlap_s = std::nullopt;
 };
 
 struct Policy {

@@ -56,6 +56,11 @@ class Reader {
   double non_negative_or(const std::string& field, double fallback) const {
     return has(field) ? non_negative(field) : fallback;
   }
+  bool boolean(const std::string& field) const {
+    const json& v = at(field);
+    if (!v.is_boolean()) fail(field, "must be true or false");
+    return v.get<bool>();
+  }
   std::string string(const std::string& field) const {
     const json& v = at(field);
     if (!v.is_string()) fail(field, "must be a string");
@@ -135,6 +140,7 @@ static void parse_spin_fields(const Reader& r, Robot& robot) {
       strut.fail("cable_attachment", "must be \"axis\" or \"surface\" (got \"" + where + "\")");
     }
   }
+  if (strut.has("rod_contact")) robot.rod_contact = strut.boolean("rod_contact");
 }
 
 Robot parse_robot(const std::string& json_text, const std::string& source) {

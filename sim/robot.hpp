@@ -47,6 +47,9 @@ struct Robot {
   // cable attachments at real end caps resist it; point-attached cables cannot.
   double axial_damping_n_m_s = 0.0;
   CableAttachment cable_attachment = CableAttachment::axis;  // strut.cable_attachment
+  // strut.rod_contact: struts collide with each other as capsules (as rigid bodies do
+  // in NTRT's Bullet world). Off, they pass through each other (docs/model.md).
+  bool rod_contact = false;
   double initial_rest_length_m = 0.0;
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;

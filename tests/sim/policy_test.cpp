@@ -131,6 +131,25 @@ TEST_F(PolicyFile, ProvenanceKeepsTheMutationScheduleAndChecksIt) {
   EXPECT_THAT(error_of(bad), HasSubstr("provenance.mutation: must be an object"));
 }
 
+TEST_F(PolicyFile, ProvenanceKeepsTheGaitsStrutGapsAndChecksThem) {
+  Policy p = parse_policy(good().dump(), robot, "p.json");
+  p.provenance.axial_spin_rms_rad_per_s = 0.5;
+  p.provenance.endcaps_touched_ground = 12;
+  const json without = json::parse(policy_to_json(p));
+  EXPECT_FALSE(without["provenance"]["gait"].contains("min_strut_gap_m")) << "not recorded: not written";
+  EXPECT_FALSE(parse_policy(without.dump(), robot, "p.json").provenance.min_strut_gap_m.has_value());
+  p.provenance.min_strut_gap_m = -0.012;
+  p.provenance.strut_overlap_s = 1.5;
+  const Policy q = parse_policy(policy_to_json(p), robot, "p.json");
+  EXPECT_EQ(q.provenance.min_strut_gap_m, -0.012);
+  EXPECT_EQ(q.provenance.strut_overlap_s, 1.5);
+  json bad = json::parse(policy_to_json(p));
+  bad["provenance"]["gait"]["strut_overlap_s"] = -1.0;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.gait.strut_overlap_s: must be >= 0"));
+  bad["provenance"]["gait"]["min_strut_gap_m"] = "close";
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.gait.min_strut_gap_m: must be a number"));
+}
+
 TEST_F(PolicyFile, NonFiniteValueIsNamed) {
   // JSON has no NaN; an overflowing literal is how a non-finite number arrives.
   std::string text = good().dump();

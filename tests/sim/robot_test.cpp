@@ -168,6 +168,20 @@ TEST(Robot, SpinFieldsAreOptionalAndValidated) {
   EXPECT_EQ(parse_robot(doc.dump(), "test.json").cable_attachment, CableAttachment::axis);
 }
 
+TEST(Robot, RodContactIsOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_FALSE(plain.rod_contact);
+  doc["strut"]["rod_contact"] = true;
+  const Robot colliding = parse_robot(doc.dump(), "test.json");
+  EXPECT_TRUE(colliding.rod_contact);
+  EXPECT_NE(colliding.hash, plain.hash);
+  doc["strut"]["rod_contact"] = "yes";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.rod_contact: must be true or false"));
+  doc["strut"]["rod_contact"] = 1;
+  EXPECT_THAT(error_of(doc), HasSubstr("strut.rod_contact: must be true or false"));
+}
+
 TEST(Robot, MissingFileIsAClearError) {
   try {
     load_robot("/nonexistent/robot.json");
