@@ -5,6 +5,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <system_error>
+
+#include "format/atomic_file.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -225,15 +228,11 @@ std::string policy_to_json(const Policy& policy) {
 }
 
 void save_policy(const std::filesystem::path& path, const Policy& policy) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) throw PolicyError(tmp.string() + ": cannot write");
-    out << policy_to_json(policy);
-    out.flush();
-    if (!out) throw PolicyError(tmp.string() + ": write failed");
+  try {
+    format::write_file_atomic(path, policy_to_json(policy));
+  } catch (const std::system_error& e) {
+    throw PolicyError(path.string() + ": cannot save: " + e.what());
   }
-  std::filesystem::rename(tmp, path);
 }
 
 core::EndcapTable endcap_table(const Policy& policy, const Robot& robot, int endcap) {

@@ -3,10 +3,12 @@
 
 #include <cstdio>
 #include <fstream>
+#include <system_error>
 
 #include <nlohmann/json.hpp>
 
 #include "firmware/app/json_reader.hpp"
+#include "format/atomic_file.hpp"
 
 namespace tensegrity::fw::app {
 namespace {
@@ -111,15 +113,12 @@ EndcapStats load_stats(const std::filesystem::path& path) {
 }
 
 bool write_stats(const std::filesystem::path& path, const EndcapStats& stats) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << to_json(stats).dump(2) << "\n";
-    if (!out.flush()) return false;
+  try {
+    format::write_file_atomic(path, to_json(stats).dump(2) + "\n", format::Durability::atomic_only);
+    return true;
+  } catch (const std::system_error&) {
+    return false;
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  return !ec;
 }
 
 }  // namespace tensegrity::fw::app

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "sim/evolve/atomic_file.hpp"
+#include "format/atomic_file.hpp"
 
 namespace tensegrity::sim::evolve {
 namespace {
@@ -114,11 +114,11 @@ void save_checkpoint(const std::filesystem::path& dir, const EvolveConfig& confi
   // the new one the current. Killed between the two renames, the directory holds
   // only the previous, which load_checkpoint then uses: nothing is lost but the
   // generation in flight, which a resume recomputes identically.
-  write_file_atomic(tmp, text);
+  format::write_file_atomic(tmp, text);
   std::error_code ec;
   if (std::filesystem::exists(current, ec)) std::filesystem::rename(current, previous);
   std::filesystem::rename(tmp, current);
-  fsync_directory(dir);
+  format::fsync_directory(dir);
 }
 
 bool checkpoint_exists(const std::filesystem::path& dir) {

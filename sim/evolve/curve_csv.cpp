@@ -3,7 +3,7 @@
 
 #include <cstdio>
 
-#include "sim/evolve/atomic_file.hpp"
+#include "format/atomic_file.hpp"
 
 namespace tensegrity::sim::evolve {
 
@@ -21,7 +21,7 @@ std::string curve_csv(const std::vector<GenerationStats>& curve) {
 }
 
 void write_curve_csv(const std::filesystem::path& path, const std::vector<GenerationStats>& curve) {
-  write_file_atomic(path, curve_csv(curve));
+  format::write_file_atomic(path, curve_csv(curve));
 }
 
 }  // namespace tensegrity::sim::evolve

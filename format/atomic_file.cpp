@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/evolve/atomic_file.hpp"
+#include "format/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -7,11 +7,20 @@
 #include <cerrno>
 #include <system_error>
 
-namespace tensegrity::sim::evolve {
+namespace tensegrity::format {
 namespace {
 
 [[noreturn]] void fail(const std::string& what, const std::filesystem::path& path) {
   throw std::system_error(errno, std::generic_category(), what + " " + path.string());
+}
+
+// Closes `fd`, removes the temporary and throws, keeping the first error's errno.
+[[noreturn]] void abandon(int fd, const std::filesystem::path& tmp, const std::string& what) {
+  const int saved = errno;
+  if (fd >= 0) ::close(fd);
+  ::unlink(tmp.c_str());
+  errno = saved;
+  fail(what, tmp);
 }
 
 }  // namespace
@@ -25,7 +34,7 @@ void fsync_directory(const std::filesystem::path& dir) {
   if (rc != 0) fail("cannot fsync directory", d);
 }
 
-void write_file_atomic(const std::filesystem::path& path, const std::string& content) {
+void write_file_atomic(const std::filesystem::path& path, const std::string& content, Durability durability) {
   const std::filesystem::path tmp = path.string() + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) fail("cannot create", tmp);
@@ -35,23 +44,16 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
     const ssize_t n = ::write(fd, data, left);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const int saved = errno;
-      ::close(fd);
-      errno = saved;
-      fail("cannot write", tmp);
+      abandon(fd, tmp, "cannot write");
     }
     data += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0) {
-    const int saved = errno;
-    ::close(fd);
-    errno = saved;
-    fail("cannot fsync", tmp);
-  }
-  if (::close(fd) != 0) fail("cannot close", tmp);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename onto", path);
-  fsync_directory(path.parent_path());
+  const bool synced = durability == Durability::synced;
+  if (synced && ::fsync(fd) != 0) abandon(fd, tmp, "cannot fsync");
+  if (::close(fd) != 0) abandon(-1, tmp, "cannot close");
+  if (::rename(tmp.c_str(), path.c_str()) != 0) abandon(-1, tmp, "cannot rename onto " + path.string() + " from");
+  if (synced) fsync_directory(path.parent_path());
 }
 
-}  // namespace tensegrity::sim::evolve
+}  // namespace tensegrity::format
