@@ -9,86 +9,13 @@
 #include <set>
 #include <sstream>
 
+#include "format/json_reader.hpp"
+
 namespace tensegrity::sim {
 namespace {
 
 using nlohmann::json;
-
-// Reads fields of one JSON object and reports errors as `source: path: message`.
-class Reader {
- public:
-  Reader(const json& j, std::string source, std::string path)
-      : j_(j), source_(std::move(source)), path_(std::move(path)) {}
-
-  [[noreturn]] void fail(const std::string& field, const std::string& message) const {
-    throw RobotError(source_ + ": " + join(field) + ": " + message);
-  }
-  std::string join(const std::string& field) const {
-    if (path_.empty()) return field;
-    if (field.empty()) return path_;
-    return field.front() == '[' ? path_ + field : path_ + "." + field;
-  }
-  const json& at(const std::string& field) const {
-    if (!j_.is_object()) fail("", "must be an object");
-    const auto it = j_.find(field);
-    if (it == j_.end()) fail(field, "missing");
-    return *it;
-  }
-  bool has(const std::string& field) const { return j_.is_object() && j_.contains(field); }
-  double number(const std::string& field) const { return as_number(at(field), field); }
-  double number_or(const std::string& field, double fallback) const { return has(field) ? number(field) : fallback; }
-  double as_number(const json& v, const std::string& field) const {
-    if (!v.is_number()) fail(field, "must be a number");
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) fail(field, "must be finite");
-    return x;
-  }
-  double positive(const std::string& field) const {
-    const double x = number(field);
-    if (!(x > 0.0)) fail(field, "must be > 0 (got " + std::to_string(x) + ")");
-    return x;
-  }
-  double non_negative(const std::string& field) const {
-    const double x = number(field);
-    if (x < 0.0) fail(field, "must be >= 0 (got " + std::to_string(x) + ")");
-    return x;
-  }
-  double non_negative_or(const std::string& field, double fallback) const {
-    return has(field) ? non_negative(field) : fallback;
-  }
-  bool boolean(const std::string& field) const {
-    const json& v = at(field);
-    if (!v.is_boolean()) fail(field, "must be true or false");
-    return v.get<bool>();
-  }
-  std::string string(const std::string& field) const {
-    const json& v = at(field);
-    if (!v.is_string()) fail(field, "must be a string");
-    return v.get<std::string>();
-  }
-  const json& array(const std::string& field) const {
-    const json& v = at(field);
-    if (!v.is_array()) fail(field, "must be an array");
-    return v;
-  }
-  Reader child(const std::string& field) const { return Reader(at(field), source_, join(field)); }
-  Reader element(const json& v, std::size_t i, const std::string& field) const {
-    return Reader(v, source_, join(field) + "[" + std::to_string(i) + "]");
-  }
-  int node_index(const json& v, const std::string& field, int node_count) const {
-    if (!v.is_number_integer()) fail(field, "must be a node index (integer)");
-    const auto i = v.get<long long>();
-    if (i < 0 || i >= node_count) {
-      fail(field, "node " + std::to_string(i) + " does not exist (" + std::to_string(node_count) + " nodes)");
-    }
-    return static_cast<int>(i);
-  }
-
- private:
-  const json& j_;
-  std::string source_;
-  std::string path_;
-};
+using Reader = format::JsonReader<RobotError>;
 
 // Bounds of plausible geometry: past them ODE aborts or the model runs with tensions
 // of 1e9 N (a node at 1e308 m, or a thousand kilometres away, was accepted before).
@@ -98,11 +25,145 @@ constexpr double kMaxStrutLengthM = 20.0;
 constexpr double kMaxStrutMassKg = 1000.0;
 constexpr double kMaxStrutRadiusM = 1.0;
 
-void check_pair(const Reader& r, const json& pair, const std::string& field, int node_count, int& a, int& b) {
-  if (!pair.is_array() || pair.size() != 2) r.fail(field, "must be a pair of node indices");
-  a = r.node_index(pair[0], field + "[0]", node_count);
-  b = r.node_index(pair[1], field + "[1]", node_count);
-  if (a == b) r.fail(field, "both ends are node " + std::to_string(a));
+int node_index(const Reader& r, const json& v, const std::string& path, int node_count) {
+  if (!v.is_number_integer()) r.fail_at(path, "must be a node index (integer)");
+  const auto i = v.get<long long>();
+  if (i < 0 || i >= node_count) {
+    r.fail_at(path, "node " + std::to_string(i) + " does not exist (" + std::to_string(node_count) + " nodes)");
+  }
+  return static_cast<int>(i);
+}
+
+void check_pair(const Reader& r, const json& pair, const std::string& path, int node_count, int& a, int& b) {
+  if (!pair.is_array() || pair.size() != 2) r.fail_at(path, "must be a pair of node indices");
+  a = node_index(r, pair[0], path + "[0]", node_count);
+  b = node_index(r, pair[1], path + "[1]", node_count);
+  if (a == b) r.fail_at(path, "both ends are node " + std::to_string(a));
+}
+
+void parse_nodes(const Reader& r, Robot& robot) {
+  const json& nodes = r.array("nodes_m");
+  if (nodes.size() < 4) r.fail("nodes_m", "needs at least 4 nodes");
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const std::string path = "nodes_m[" + std::to_string(i) + "]";
+    if (!nodes[i].is_array() || nodes[i].size() != 3) r.fail_at(path, "must be [x, y, z]");
+    Eigen::Vector3d p;
+    for (int k = 0; k < 3; ++k) {
+      const std::string coordinate = path + "[" + std::to_string(k) + "]";
+      p[k] = r.number_at(nodes[i][k], coordinate);
+      if (std::abs(p[k]) > kMaxCoordinateM) r.fail_at(coordinate, "must be within +-100 m of the origin");
+    }
+    robot.nodes_m.push_back(p);
+  }
+}
+
+// The fields that decide how struts turn about their own axes and whether they
+// collide (docs/model.md) are optional, so that older robot files keep their behaviour.
+void parse_strut(const Reader& r, Robot& robot) {
+  const Reader strut = r.object("strut");
+  robot.strut_mass_kg = strut.positive("mass_kg", 0.0, true);
+  robot.strut_radius_m = strut.positive("radius_m", 0.0, true);
+  if (robot.strut_mass_kg > kMaxStrutMassKg) strut.fail("mass_kg", "must be at most 1000 kg");
+  if (robot.strut_radius_m > kMaxStrutRadiusM) strut.fail("radius_m", "must be at most 1 m");
+  robot.axial_damping_n_m_s = strut.non_negative("axial_damping_n_m_s", 0.0);
+  if (strut.has("cable_attachment")) {
+    const std::string where = strut.string("cable_attachment", true);
+    if (where == "axis") {
+      robot.cable_attachment = CableAttachment::axis;
+    } else if (where == "surface") {
+      robot.cable_attachment = CableAttachment::surface;
+    } else {
+      strut.fail("cable_attachment", "must be \"axis\" or \"surface\" (got \"" + where + "\")");
+    }
+  }
+  robot.rod_contact = strut.boolean("rod_contact", false);
+}
+
+// Returns each node's strut.
+std::vector<int> parse_struts(const Reader& r, Robot& robot) {
+  const int n = robot.node_count();
+  const json& struts = r.array("struts");
+  std::vector<int> strut_of(n, -1);
+  for (std::size_t i = 0; i < struts.size(); ++i) {
+    const std::string path = "struts[" + std::to_string(i) + "]";
+    StrutSpec s;
+    check_pair(r, struts[i], path, n, s.node_a, s.node_b);
+    for (const int node : {s.node_a, s.node_b}) {
+      if (strut_of[node] >= 0) {
+        r.fail_at(path, "node " + std::to_string(node) + " is already an end of struts[" +
+                            std::to_string(strut_of[node]) + "]");
+      }
+      strut_of[node] = static_cast<int>(i);
+    }
+    const double length = (robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm();
+    if (length < 4.0 * robot.strut_radius_m) r.fail_at(path, "strut is shorter than four radii");
+    if (length > kMaxStrutLengthM) r.fail_at(path, "strut is longer than 20 m");
+    robot.struts.push_back(s);
+  }
+  for (int node = 0; node < n; ++node) {
+    if (strut_of[node] < 0) r.fail("struts", "node " + std::to_string(node) + " is the end of no strut");
+  }
+  return strut_of;
+}
+
+void parse_cable_defaults(const Reader& r, Robot& robot) {
+  const Reader cable = r.object("cable");
+  robot.motor.min_rest_length_m = cable.positive("min_rest_length_m", 0.0, true);
+  robot.motor.max_rest_length_m = cable.positive("max_rest_length_m", 0.0, true);
+  if (robot.motor.max_rest_length_m <= robot.motor.min_rest_length_m) {
+    cable.fail("max_rest_length_m", "must be greater than min_rest_length_m");
+  }
+  robot.initial_rest_length_m = cable.positive("initial_rest_length_m", 0.0, true);
+  if (robot.initial_rest_length_m < robot.motor.min_rest_length_m ||
+      robot.initial_rest_length_m > robot.motor.max_rest_length_m) {
+    cable.fail("initial_rest_length_m", "must lie within [min_rest_length_m, max_rest_length_m]");
+  }
+  robot.motor.speed_m_per_s = cable.positive("motor_speed_m_per_s", 0.0, true);
+  robot.motor.cutoff_tension_n = cable.positive("cutoff_tension_n", 0.0, true);
+  robot.motor.hard_limit_tension_n = cable.positive("hard_limit_tension_n", 0.0, true);
+  if (robot.motor.hard_limit_tension_n < robot.motor.cutoff_tension_n) {
+    cable.fail("hard_limit_tension_n", "must be at least cutoff_tension_n");
+  }
+}
+
+void parse_cables(const Reader& r, const std::vector<int>& strut_of, Robot& robot) {
+  const Reader defaults = r.object("cable");
+  const double k_default = defaults.positive("stiffness_n_per_m", 0.0, true);
+  const double c_default = defaults.non_negative("damping_n_s_per_m");
+  const int n = robot.node_count();
+  const json& cables = r.array("cables");
+  if (cables.empty()) r.fail("cables", "needs at least one cable");
+  std::set<std::pair<int, int>> seen;
+  for (std::size_t i = 0; i < cables.size(); ++i) {
+    const Reader c = r.element("cables", i);
+    CableSpec spec;
+    check_pair(r, c.at("nodes"), c.field("nodes"), n, spec.node_a, spec.node_b);
+    if (strut_of[spec.node_a] == strut_of[spec.node_b]) {
+      c.fail("nodes",
+             "both ends are on struts[" + std::to_string(strut_of[spec.node_a]) + "]: a cable must join two struts");
+    }
+    const auto key = std::minmax(spec.node_a, spec.node_b);
+    if (!seen.insert(key).second) c.fail("nodes", "duplicate cable between these nodes");
+    spec.owner = node_index(r, c.at("owner"), c.field("owner"), n);
+    if (spec.owner != spec.node_a && spec.owner != spec.node_b) {
+      c.fail("owner", "end cap " + std::to_string(spec.owner) + " is not an end of this cable");
+    }
+    spec.stiffness_n_per_m = c.positive("stiffness_n_per_m", k_default);
+    spec.damping_n_s_per_m = c.non_negative("damping_n_s_per_m", c_default);
+    robot.cables.push_back(spec);
+  }
+}
+
+void parse_ground_and_start(const Reader& r, Robot& robot) {
+  const Reader ground = r.object("ground");
+  robot.ground_friction = ground.non_negative("friction");
+  robot.ground_restitution = ground.non_negative("restitution", 0.0);
+  if (robot.ground_restitution > 1.0) ground.fail("restitution", "must be within [0, 1]");
+  robot.contact_stiffness_n_per_m = ground.positive("contact_stiffness_n_per_m", 0.0, true);
+  robot.contact_damping_n_s_per_m = ground.non_negative("contact_damping_n_s_per_m");
+  const Reader start = r.object("start");
+  robot.start_clearance_m = start.non_negative("clearance_m");
+  robot.settle_s = start.non_negative("settle_s");
 }
 
 }  // namespace
@@ -126,23 +187,6 @@ std::vector<int> Robot::cables_of(int endcap) const {
   return out;
 }
 
-// The fields that decide how struts turn about their own axes (docs/model.md), read
-// apart so that robot files without them keep their behaviour.
-static void parse_spin_fields(const Reader& r, Robot& robot) {
-  const Reader strut = r.child("strut");
-  if (strut.has("cable_attachment")) {
-    const std::string where = strut.string("cable_attachment");
-    if (where == "axis") {
-      robot.cable_attachment = CableAttachment::axis;
-    } else if (where == "surface") {
-      robot.cable_attachment = CableAttachment::surface;
-    } else {
-      strut.fail("cable_attachment", "must be \"axis\" or \"surface\" (got \"" + where + "\")");
-    }
-  }
-  if (strut.has("rod_contact")) robot.rod_contact = strut.boolean("rod_contact");
-}
-
 Robot parse_robot(const std::string& json_text, const std::string& source) {
   json doc;
   try {
@@ -152,119 +196,19 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   }
   const Reader r(doc, source, "");
   Robot robot;
-  if (const auto format = r.string("format"); format != "tensegrity-robot/1") {
+  if (const auto format = r.string("format", true); format != "tensegrity-robot/1") {
     r.fail("format", "expected \"tensegrity-robot/1\", got \"" + format + "\"");
   }
   robot.name = r.string("name");
-  if (robot.name.empty()) r.fail("name", "must not be empty");
   robot.gravity_m_per_s2 = r.non_negative("gravity_m_per_s2");
-  robot.time_step_s = r.positive("time_step_s");
+  robot.time_step_s = r.positive("time_step_s", 0.0, true);
   if (robot.time_step_s > 0.01) r.fail("time_step_s", "must be at most 0.01 s (the model is unstable above)");
-
-  const json& nodes = r.array("nodes_m");
-  if (nodes.size() < 4) r.fail("nodes_m", "needs at least 4 nodes");
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    const std::string field = "nodes_m[" + std::to_string(i) + "]";
-    if (!nodes[i].is_array() || nodes[i].size() != 3) r.fail(field, "must be [x, y, z]");
-    Eigen::Vector3d p;
-    for (int k = 0; k < 3; ++k) {
-      const std::string coordinate = field + "[" + std::to_string(k) + "]";
-      p[k] = r.as_number(nodes[i][k], coordinate);
-      if (std::abs(p[k]) > kMaxCoordinateM) r.fail(coordinate, "must be within +-100 m of the origin");
-    }
-    robot.nodes_m.push_back(p);
-  }
-  const int n = robot.node_count();
-
-  const Reader strut = r.child("strut");
-  robot.strut_mass_kg = strut.positive("mass_kg");
-  robot.strut_radius_m = strut.positive("radius_m");
-  if (robot.strut_mass_kg > kMaxStrutMassKg) strut.fail("mass_kg", "must be at most 1000 kg");
-  if (robot.strut_radius_m > kMaxStrutRadiusM) strut.fail("radius_m", "must be at most 1 m");
-  robot.axial_damping_n_m_s = strut.non_negative_or("axial_damping_n_m_s", 0.0);
-
-  const json& struts = r.array("struts");
-  std::vector<int> strut_of(n, -1);
-  for (std::size_t i = 0; i < struts.size(); ++i) {
-    const std::string field = "struts[" + std::to_string(i) + "]";
-    StrutSpec s;
-    check_pair(r, struts[i], field, n, s.node_a, s.node_b);
-    for (const int node : {s.node_a, s.node_b}) {
-      if (strut_of[node] >= 0) {
-        r.fail(field,
-               "node " + std::to_string(node) + " is already an end of struts[" + std::to_string(strut_of[node]) + "]");
-      }
-      strut_of[node] = static_cast<int>(i);
-    }
-    if ((robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm() < 4.0 * robot.strut_radius_m) {
-      r.fail(field, "strut is shorter than four radii");
-    }
-    if ((robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm() > kMaxStrutLengthM) {
-      r.fail(field, "strut is longer than 20 m");
-    }
-    robot.struts.push_back(s);
-  }
-  for (int node = 0; node < n; ++node) {
-    if (strut_of[node] < 0) r.fail("struts", "node " + std::to_string(node) + " is the end of no strut");
-  }
-
-  const Reader cable = r.child("cable");
-  const double k_default = cable.positive("stiffness_n_per_m");
-  const double c_default = cable.non_negative("damping_n_s_per_m");
-  robot.motor.min_rest_length_m = cable.positive("min_rest_length_m");
-  robot.motor.max_rest_length_m = cable.positive("max_rest_length_m");
-  if (robot.motor.max_rest_length_m <= robot.motor.min_rest_length_m) {
-    cable.fail("max_rest_length_m", "must be greater than min_rest_length_m");
-  }
-  robot.initial_rest_length_m = cable.positive("initial_rest_length_m");
-  if (robot.initial_rest_length_m < robot.motor.min_rest_length_m ||
-      robot.initial_rest_length_m > robot.motor.max_rest_length_m) {
-    cable.fail("initial_rest_length_m", "must lie within [min_rest_length_m, max_rest_length_m]");
-  }
-  robot.motor.speed_m_per_s = cable.positive("motor_speed_m_per_s");
-  robot.motor.cutoff_tension_n = cable.positive("cutoff_tension_n");
-  robot.motor.hard_limit_tension_n = cable.positive("hard_limit_tension_n");
-  if (robot.motor.hard_limit_tension_n < robot.motor.cutoff_tension_n) {
-    cable.fail("hard_limit_tension_n", "must be at least cutoff_tension_n");
-  }
-
-  const json& cables = r.array("cables");
-  if (cables.empty()) r.fail("cables", "needs at least one cable");
-  std::set<std::pair<int, int>> seen;
-  for (std::size_t i = 0; i < cables.size(); ++i) {
-    const Reader c = r.element(cables[i], i, "cables");
-    const std::string field = "cables[" + std::to_string(i) + "]";
-    if (!cables[i].is_object()) r.fail(field, "must be an object");
-    CableSpec spec;
-    check_pair(r, c.at("nodes"), field + ".nodes", n, spec.node_a, spec.node_b);
-    if (strut_of[spec.node_a] == strut_of[spec.node_b]) {
-      c.fail("nodes",
-             "both ends are on struts[" + std::to_string(strut_of[spec.node_a]) + "]: a cable must join two struts");
-    }
-    const auto key = std::minmax(spec.node_a, spec.node_b);
-    if (!seen.insert(key).second) c.fail("nodes", "duplicate cable between these nodes");
-    spec.owner = r.node_index(c.at("owner"), field + ".owner", n);
-    if (spec.owner != spec.node_a && spec.owner != spec.node_b) {
-      c.fail("owner", "end cap " + std::to_string(spec.owner) + " is not an end of this cable");
-    }
-    spec.stiffness_n_per_m = c.has("stiffness_n_per_m") ? c.positive("stiffness_n_per_m") : k_default;
-    spec.damping_n_s_per_m = c.has("damping_n_s_per_m") ? c.non_negative("damping_n_s_per_m") : c_default;
-    robot.cables.push_back(spec);
-  }
-
-  const Reader ground = r.child("ground");
-  robot.ground_friction = ground.non_negative("friction");
-  robot.ground_restitution = ground.non_negative_or("restitution", 0.0);
-  if (robot.ground_restitution > 1.0) ground.fail("restitution", "must be within [0, 1]");
-  robot.contact_stiffness_n_per_m = ground.positive("contact_stiffness_n_per_m");
-  robot.contact_damping_n_s_per_m = ground.non_negative("contact_damping_n_s_per_m");
-
-  const Reader start = r.child("start");
-  robot.start_clearance_m = start.non_negative("clearance_m");
-  robot.settle_s = start.non_negative("settle_s");
-
-  parse_spin_fields(r, robot);
-
+  parse_nodes(r, robot);
+  parse_strut(r, robot);
+  const std::vector<int> strut_of = parse_struts(r, robot);
+  parse_cable_defaults(r, robot);
+  parse_cables(r, strut_of, robot);
+  parse_ground_and_start(r, robot);
   robot.hash = fnv1a64_hex(doc.dump());
   return robot;
 }

@@ -10,16 +10,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/app/json_reader.hpp"
 #include "firmware/core/table.hpp"
 #include "firmware/hal/can_bus_spec.hpp"
+#include "format/json_reader.hpp"
 
 namespace tensegrity::fw::app {
 namespace {
 
 using json = nlohmann::json;
 
-using Reader = JsonReader<ConfigError>;
+using Reader = format::JsonReader<ConfigError>;
 
 std::uint8_t node_id(const Reader& r, const json& v, const std::string& key) {
   if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 127) {

@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/app/json_reader.hpp"
 #include "format/atomic_file.hpp"
+#include "format/json_reader.hpp"
 
 namespace tensegrity::fw::app {
 namespace {
@@ -19,7 +19,7 @@ json timing_json(const TimingStats& t) {
   return {{"count", t.count}, {"p50_us", t.p50_us}, {"p99_us", t.p99_us}, {"max_us", t.max_us}};
 }
 
-using Fields = JsonReader<StatsError>;
+using Fields = format::JsonReader<StatsError>;
 
 TimingStats parse_timing(const Fields& f) {
   return {f.count("count"), f.number("p50_us"), f.number("p99_us"), f.number("max_us")};

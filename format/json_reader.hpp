@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// Reading one JSON object of a file the end cap's programs exchange (its config,
-// its stats) with errors that name the file and the field's path
-// ("endcap.json: timeouts.drive_heartbeat_s: must be > 0"), and without nlohmann's
-// silent conversions (-1 read as a count, 2.5 as an integer). `Error` is the
-// exception the caller's users catch (ConfigError, StatsError).
+// Reading one JSON object of a file the project's processes exchange (the end cap's
+// config and stats, robot descriptions) with errors that name the file and the
+// field's path ("endcap.json: timeouts.drive_heartbeat_s: must be > 0",
+// "superball.json: cables[3].nodes[1]: node 12 does not exist"), and without
+// nlohmann's silent conversions (-1 read as a count, 2.5 as an integer). `Error` is
+// the exception the caller's users catch (ConfigError, StatsError, RobotError).
 #pragma once
 
 #include <cmath>
@@ -14,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace tensegrity::fw::app {
+namespace tensegrity::format {
 
 template <typename Error>
 class JsonReader {
@@ -98,6 +99,34 @@ class JsonReader {
     at(key);
     return boolean(key, false);
   }
+  double non_negative(const char* key, double fallback, bool required = false) const {
+    const double x = number(key, fallback, required);
+    if (x < 0.0) fail(key, "must be >= 0");
+    return x;
+  }
+  double non_negative(const char* key) const { return non_negative(key, 0.0, true); }
+
+  // Arrays: the array itself, and paths and values of its elements, which need not
+  // be objects ("nodes_m[3][1]").
+  const json& array(const char* key) const {
+    const json& v = at(key);
+    if (!v.is_array()) fail(key, "must be an array");
+    return v;
+  }
+  // An element that is an object, read with its own path ("cables[4]").
+  JsonReader element(const char* key, std::size_t i) const {
+    return JsonReader(array(key).at(i), source_, field(key) + "[" + std::to_string(i) + "]");
+  }
+  // `path` as field() makes it, with any [i] appended.
+  [[noreturn]] void fail_at(const std::string& path, const std::string& what) const {
+    throw Error(source_ + ": " + path + ": " + what);
+  }
+  double number_at(const json& v, const std::string& path) const {
+    if (!v.is_number()) fail_at(path, "must be a number");
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail_at(path, "must be finite");
+    return x;
+  }
 
  private:
   const json& j_;
@@ -105,4 +134,4 @@ class JsonReader {
   std::string path_;
 };
 
-}  // namespace tensegrity::fw::app
+}  // namespace tensegrity::format
