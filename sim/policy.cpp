@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "format/atomic_file.hpp"
+#include "format/policy_format.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -16,13 +17,6 @@ using nlohmann::json;
 
 [[noreturn]] void fail(const std::string& source, const std::string& field, const std::string& message) {
   throw PolicyError(source + ": " + field + ": " + message);
-}
-
-const json& need(const json& j, const std::string& key, const std::string& source, const std::string& path) {
-  if (!j.is_object()) fail(source, path.empty() ? "(top)" : path, "must be an object");
-  const auto it = j.find(key);
-  if (it == j.end()) fail(source, path.empty() ? key : path + "." + key, "missing");
-  return *it;
 }
 
 double finite_number(const json& v, const std::string& source, const std::string& field) {
@@ -64,105 +58,80 @@ void read_gait(const json& provenance, const Robot& robot, const std::string& so
 
 }  // namespace
 
-Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw PolicyError(source + ": not valid JSON: " + e.what());
-  }
-  Policy policy;
-  const json& format = need(doc, "format", source, "");
-  if (!format.is_string() || format.get<std::string>() != "tensegrity-policy/1") {
-    fail(source, "format", "expected \"tensegrity-policy/1\"");
-  }
-  const json& name = need(doc, "robot", source, "");
-  if (!name.is_string()) fail(source, "robot", "must be a string");
-  policy.robot = name.get<std::string>();
-  if (policy.robot != robot.name) {
-    fail(source, "robot", "policy is for robot \"" + policy.robot + "\", not \"" + robot.name + "\"");
-  }
-  policy.period_s = finite_number(need(doc, "period_s", source, ""), source, "period_s");
-  if (!(policy.period_s > 0.0) || policy.period_s > 3600.0) fail(source, "period_s", "must be within (0, 3600] s");
-  const long long complexity = integer(need(doc, "complexity", source, ""), source, "complexity");
-  if (complexity < 1 || complexity > static_cast<long long>(core::kMaxComplexity)) {
-    fail(source, "complexity", "must be 1.." + std::to_string(core::kMaxComplexity));
-  }
-  policy.complexity = static_cast<int>(complexity);
+namespace {
 
-  const json& cables = need(doc, "cables", source, "");
-  if (!cables.is_array()) fail(source, "cables", "must be an array");
-  if (static_cast<int>(cables.size()) != robot.cable_count()) {
+// The provenance's fields beside the gait (read_gait), checked where present.
+void read_provenance(const json& p, const std::string& source, Provenance& pr) {
+  pr.method = p.value("method", "");
+  if (p.contains("seed")) pr.seed = static_cast<std::uint64_t>(integer(p["seed"], source, "provenance.seed"));
+  if (p.contains("episodes")) pr.episodes = integer(p["episodes"], source, "provenance.episodes");
+  if (p.contains("score_m")) pr.score_m = finite_number(p["score_m"], source, "provenance.score_m");
+  pr.robot_hash = p.value("robot_hash", "");
+  pr.created_by = p.value("created_by", "");
+  const auto m = p.find("mutation");
+  if (m == p.end()) return;
+  if (!m->is_object()) fail(source, "provenance.mutation", "must be an object");
+  // Policies from before the author's operator existed were bred by the Gaussian one.
+  const json op = m->value("operator", json("gaussian"));
+  if (!op.is_string() || (op != "gaussian" && op != "author")) {
+    fail(source, "provenance.mutation.operator", "must be \"gaussian\" or \"author\"");
+  }
+  pr.mutation = op.get<std::string>();
+  pr.sigma_m = finite_number(m->value("sigma_m", json()), source, "provenance.mutation.sigma_m");
+  pr.sigma_final_m = finite_number(m->value("sigma_final_m", json()), source, "provenance.mutation.sigma_final_m");
+  pr.anneal_episodes = integer(m->value("anneal_episodes", json()), source, "provenance.mutation.anneal_episodes");
+  pr.anneal_start_episodes =
+      integer(m->value("anneal_start_episodes", json(0)), source, "provenance.mutation.anneal_start_episodes");
+  if (pr.sigma_m < 0.0 || pr.sigma_final_m < 0.0 || pr.anneal_episodes < 0 || pr.anneal_start_episodes < 0) {
+    fail(source, "provenance.mutation", "steps and anneal_episodes must be >= 0");
+  }
+}
+
+// What the file must be for this robot: its name, one entry per cable, each owned
+// as the robot says, every rest length within the robot's limits.
+void check_against_robot(const format::PolicyDocument& doc, const Robot& robot, const std::string& source) {
+  if (doc.robot.empty()) fail(source, "robot", "missing");
+  if (doc.robot != robot.name) {
+    fail(source, "robot", "policy is for robot \"" + doc.robot + "\", not \"" + robot.name + "\"");
+  }
+  if (static_cast<int>(doc.cables.size()) != robot.cable_count()) {
     fail(source, "cables",
-         "has " + std::to_string(cables.size()) + " entries, the robot has " + std::to_string(robot.cable_count()) +
+         "has " + std::to_string(doc.cables.size()) + " entries, the robot has " + std::to_string(robot.cable_count()) +
              " cables");
   }
-  policy.cables.resize(cables.size());
-  std::vector<bool> seen(cables.size(), false);
-  for (std::size_t i = 0; i < cables.size(); ++i) {
+  for (std::size_t i = 0; i < doc.cables.size(); ++i) {
     const std::string path = "cables[" + std::to_string(i) + "]";
-    const json& entry = cables[i];
-    const long long index = integer(need(entry, "cable", source, path), source, path + ".cable");
-    if (index < 0 || index >= robot.cable_count()) fail(source, path + ".cable", "no such cable");
-    if (seen[index]) fail(source, path + ".cable", "cable " + std::to_string(index) + " appears twice");
-    seen[index] = true;
-    CablePolicy& cable = policy.cables[index];
-    cable.cable = static_cast<int>(index);
-    const long long owner = integer(need(entry, "owner", source, path), source, path + ".owner");
-    if (owner != robot.cables[index].owner) {
+    const format::PolicyCable& c = doc.cables[i];
+    if (c.cable >= robot.cable_count()) fail(source, path + ".cable", "no such cable");
+    if (c.owner != robot.cables[c.cable].owner) {
       fail(source, path + ".owner",
-           "cable " + std::to_string(index) + " is owned by end cap " + std::to_string(robot.cables[index].owner) +
-               ", not " + std::to_string(owner));
+           "cable " + std::to_string(c.cable) + " is owned by end cap " + std::to_string(robot.cables[c.cable].owner) +
+               ", not " + std::to_string(c.owner));
     }
-    cable.owner = static_cast<int>(owner);
-    const json& values = need(entry, "rest_lengths_m", source, path);
-    if (!values.is_array() || static_cast<long long>(values.size()) != complexity) {
-      fail(source, path + ".rest_lengths_m", "must hold exactly " + std::to_string(complexity) + " values");
-    }
-    for (std::size_t j = 0; j < values.size(); ++j) {
-      const std::string field = path + ".rest_lengths_m[" + std::to_string(j) + "]";
-      const double v = finite_number(values[j], source, field);
-      if (v < robot.motor.min_rest_length_m || v > robot.motor.max_rest_length_m) {
-        std::ostringstream msg;
-        msg << v << " m is outside the rest-length limits [" << robot.motor.min_rest_length_m << ", "
-            << robot.motor.max_rest_length_m << "] m";
-        fail(source, field, msg.str());
-      }
-      cable.rest_lengths_m.push_back(v);
-    }
+    format::check_rest_lengths(doc, i, robot.motor, source);
   }
+}
 
-  if (const auto it = doc.find("provenance"); it != doc.end()) {
-    const json& p = *it;
-    if (!p.is_object()) fail(source, "provenance", "must be an object");
-    policy.provenance.method = p.value("method", "");
-    if (p.contains("seed"))
-      policy.provenance.seed = static_cast<std::uint64_t>(integer(p["seed"], source, "provenance.seed"));
-    if (p.contains("episodes")) policy.provenance.episodes = integer(p["episodes"], source, "provenance.episodes");
-    if (p.contains("score_m")) policy.provenance.score_m = finite_number(p["score_m"], source, "provenance.score_m");
-    policy.provenance.robot_hash = p.value("robot_hash", "");
-    policy.provenance.created_by = p.value("created_by", "");
-    if (const auto m = p.find("mutation"); m != p.end()) {
-      if (!m->is_object()) fail(source, "provenance.mutation", "must be an object");
-      Provenance& pr = policy.provenance;
-      // Policies from before the author's operator existed were bred by the Gaussian one.
-      const json op = m->value("operator", json("gaussian"));
-      if (!op.is_string() || (op != "gaussian" && op != "author")) {
-        fail(source, "provenance.mutation.operator", "must be \"gaussian\" or \"author\"");
-      }
-      pr.mutation = op.get<std::string>();
-      pr.sigma_m = finite_number(m->value("sigma_m", json()), source, "provenance.mutation.sigma_m");
-      pr.sigma_final_m = finite_number(m->value("sigma_final_m", json()), source, "provenance.mutation.sigma_final_m");
-      pr.anneal_episodes = integer(m->value("anneal_episodes", json()), source, "provenance.mutation.anneal_episodes");
-      pr.anneal_start_episodes =
-          integer(m->value("anneal_start_episodes", json(0)), source, "provenance.mutation.anneal_start_episodes");
-      if (pr.sigma_m < 0.0 || pr.sigma_final_m < 0.0 || pr.anneal_episodes < 0 || pr.anneal_start_episodes < 0) {
-        fail(source, "provenance.mutation", "steps and anneal_episodes must be >= 0");
-      }
+}  // namespace
+
+Policy parse_policy(const std::string& json_text, const Robot& robot, const std::string& source) {
+  try {
+    const format::PolicyDocument doc = format::parse_policy_document(json_text, source);
+    check_against_robot(doc, robot, source);
+    Policy policy;
+    policy.robot = doc.robot;
+    policy.period_s = doc.period_s;
+    policy.complexity = doc.complexity;
+    policy.cables.resize(doc.cables.size());
+    for (const format::PolicyCable& c : doc.cables) policy.cables[c.cable] = {c.cable, c.owner, c.rest_lengths_m};
+    if (doc.provenance.is_object()) {
+      read_provenance(doc.provenance, source, policy.provenance);
+      read_gait(doc.provenance, robot, source, policy.provenance);
     }
+    return policy;
+  } catch (const format::PolicyFormatError& e) {
+    throw PolicyError(e.what());
   }
-  if (const auto it = doc.find("provenance"); it != doc.end()) read_gait(*it, robot, source, policy.provenance);
-  return policy;
 }
 
 Policy load_policy(const std::filesystem::path& path, const Robot& robot) {

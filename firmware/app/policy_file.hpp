@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // This end cap's share of a policy file ("tensegrity-policy/1", written by the
-// simulator: sim/policy.hpp). Parsed here with nlohmann-json instead of linking
-// the simulator, which would drag ODE and the robot model onto the end cap. The
-// share is the cables whose "owner" is this end cap, in increasing cable index:
-// the same rule as sim::endcap_table, so motor m plays the same column everywhere.
+// simulator: sim/policy.hpp), read by the one policy-format parser every process
+// uses (format/policy_format.hpp). The share is the cables whose "owner" is this
+// end cap, in increasing cable index: the same rule as sim::endcap_table, so motor
+// m plays the same column everywhere.
 #pragma once
 
 #include <filesystem>

@@ -5,7 +5,6 @@
 
 namespace tensegrity::core {
 namespace {
-constexpr double kMaxPeriodS = 3600.0;
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
   std::int64_t q = a / b;

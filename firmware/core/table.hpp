@@ -10,6 +10,9 @@
 
 namespace tensegrity::core {
 
+// The longest period a table may have: table time is kept in integer nanoseconds.
+inline constexpr double kMaxPeriodS = 3600.0;
+
 struct EndcapTable {
   std::uint32_t motor_count = 0;
   std::uint32_t complexity = 0;
