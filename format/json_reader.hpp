@@ -17,6 +17,16 @@
 
 namespace tensegrity::format {
 
+// Parses `text`, or throws Error("source: not valid JSON: ...").
+template <typename Error>
+nlohmann::json parse_json(const std::string& text, const std::string& source) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(source + ": not valid JSON: " + e.what());
+  }
+}
+
 template <typename Error>
 class JsonReader {
  public:

@@ -35,12 +35,7 @@ PolicyCable parse_cable(const Reader& entry, int complexity) {
 }  // namespace
 
 PolicyDocument parse_policy_document(const std::string& json_text, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw PolicyFormatError(source + ": not valid JSON: " + e.what());
-  }
+  const json doc = parse_json<PolicyFormatError>(json_text, source);
   const Reader r(doc, source, "");
   if (!r.has("format") || !r.at("format").is_string() || r.at("format").get<std::string>() != kPolicyFormat) {
     r.fail("format", std::string("expected \"") + kPolicyFormat + "\"");

@@ -188,12 +188,7 @@ std::vector<int> Robot::cables_of(int endcap) const {
 }
 
 Robot parse_robot(const std::string& json_text, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw RobotError(source + ": not valid JSON: " + e.what());
-  }
+  const json doc = format::parse_json<RobotError>(json_text, source);
   const Reader r(doc, source, "");
   Robot robot;
   if (const auto format = r.string("format", true); format != "tensegrity-robot/1") {

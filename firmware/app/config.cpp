@@ -86,12 +86,7 @@ const char* to_string(LoopMode mode) { return mode == LoopMode::lockstep ? "lock
 std::int64_t EndcapAppConfig::period_ns() const { return static_cast<std::int64_t>(std::llround(1e9 / loop_rate_hz)); }
 
 EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw ConfigError(source + ": not valid JSON: " + e.what());
-  }
+  const json doc = format::parse_json<ConfigError>(json_text, source);
   const Reader top(doc, source, "");
   top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
             "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore"});
