@@ -22,11 +22,3 @@ if(TENSEGRITY_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
 endif()
-
-# Every project library/executable: warnings on, the repository root as include
-# root so that an include line names the room it reaches into
-# (#include "firmware/core/motor_loop.hpp").
-function(tensegrity_target_defaults target)
-  target_link_libraries(${target} PRIVATE tensegrity::warnings)
-  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
-endfunction()

@@ -10,10 +10,11 @@ the room's system rule ("std": the C++ standard library only, as firmware/core m
 "forbid": prefixes such as fastdds/ that the room must not touch). A violation names
 the file, the line, the include and the rule.
 
-Why a script and not include directories per target: every include here is written
-from the repository root ("firmware/app/mailbox.hpp"), which reads well and greps
-well, and a root include directory then reaches every header; the table says what
-CMake cannot.
+The build enforces half of this by itself (cmake/Rooms.cmake): each room's target
+exports an include root holding its own headers only, so a header of a room the
+target does not link does not compile. This script keeps the other half, which
+CMake cannot see: that the rooms a room links are the ones the table allows, and
+the rules on system headers.
 
   scripts/check_layers.py [--self-test]
 """
