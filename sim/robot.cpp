@@ -110,19 +110,17 @@ void parse_cable_defaults(const Reader& r, Robot& robot) {
   const Reader cable = r.object("cable");
   robot.motor.min_rest_length_m = cable.positive("min_rest_length_m", 0.0, true);
   robot.motor.max_rest_length_m = cable.positive("max_rest_length_m", 0.0, true);
-  if (robot.motor.max_rest_length_m <= robot.motor.min_rest_length_m) {
-    cable.fail("max_rest_length_m", "must be greater than min_rest_length_m");
+  robot.motor.speed_m_per_s = cable.positive("motor_speed_m_per_s", 0.0, true);
+  robot.motor.cutoff_tension_n = cable.positive("cutoff_tension_n", 0.0, true);
+  robot.motor.hard_limit_tension_n = cable.positive("hard_limit_tension_n", 0.0, true);
+  // The end cap's own check of its limits (its config is checked by the same).
+  if (const core::LimitsError e = core::validate(robot.motor); e != core::LimitsError::none) {
+    cable.fail(core::field_of(e), core::describe(e));
   }
   robot.initial_rest_length_m = cable.positive("initial_rest_length_m", 0.0, true);
   if (robot.initial_rest_length_m < robot.motor.min_rest_length_m ||
       robot.initial_rest_length_m > robot.motor.max_rest_length_m) {
     cable.fail("initial_rest_length_m", "must lie within [min_rest_length_m, max_rest_length_m]");
-  }
-  robot.motor.speed_m_per_s = cable.positive("motor_speed_m_per_s", 0.0, true);
-  robot.motor.cutoff_tension_n = cable.positive("cutoff_tension_n", 0.0, true);
-  robot.motor.hard_limit_tension_n = cable.positive("hard_limit_tension_n", 0.0, true);
-  if (robot.motor.hard_limit_tension_n < robot.motor.cutoff_tension_n) {
-    cable.fail("hard_limit_tension_n", "must be at least cutoff_tension_n");
   }
 }
 
@@ -164,6 +162,16 @@ void parse_ground_and_start(const Reader& r, Robot& robot) {
   const Reader start = r.object("start");
   robot.start_clearance_m = start.non_negative("clearance_m");
   robot.settle_s = start.non_negative("settle_s");
+  if (start.has("pose")) {
+    const std::string pose = start.string("pose");
+    if (pose == "face_down") {
+      robot.start_pose = Robot::StartPose::face_down;
+    } else if (pose == "description") {
+      robot.start_pose = Robot::StartPose::description;
+    } else {
+      start.fail("pose", "must be \"face_down\" or \"description\", not \"" + pose + "\"");
+    }
+  }
 }
 
 }  // namespace

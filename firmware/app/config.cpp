@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/core/limits.hpp"
 #include "firmware/core/table.hpp"
 #include "firmware/hal/can_bus_spec.hpp"
 #include "format/json_reader.hpp"
@@ -79,29 +80,8 @@ void parse_abort_connection(const Reader& top, EndcapAppConfig& c) {
   }
 }
 
-}  // namespace
-
-const char* to_string(LoopMode mode) { return mode == LoopMode::lockstep ? "lockstep" : "realtime"; }
-
-std::int64_t EndcapAppConfig::period_ns() const { return static_cast<std::int64_t>(std::llround(1e9 / loop_rate_hz)); }
-
-EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source) {
-  const json doc = format::parse_json<ConfigError>(json_text, source);
-  const Reader top(doc, source, "");
-  top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
-            "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore"});
-  if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
-
-  EndcapAppConfig c;
-  if (endcap_id < 0 || endcap_id > 11)
-    throw ConfigError("--id: end cap id must be 0..11, not " + std::to_string(endcap_id));
-  c.endcap_id = endcap_id;
-
-  c.bus = top.string("bus");
-  CanBusSpec spec;
-  std::string error;
-  if (!parse_can_bus_spec(c.bus, spec, error)) top.fail("bus", error);
-
+// Drive, load-cell and end-cap node ids: each 1..127, none used twice.
+void parse_nodes(const Reader& top, EndcapAppConfig& c) {
   const Reader nodes = top.object("nodes");
   nodes.only({"drives", "load_cell", "endcap"});
   const json& drives = nodes.at("drives");
@@ -129,7 +109,9 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   } else if (!seen.insert(c.endcap_node_id).second) {
     nodes.fail("endcap", "the default end-cap node id 127 is taken: give another");
   }
+}
 
+void parse_spool_and_limits(const Reader& top, EndcapAppConfig& c) {
   const Reader spool = top.object("spool");
   spool.only({"radius_m", "counts_per_rev"});
   c.spool_radius_m = spool.positive("radius_m", 0, true);
@@ -143,10 +125,55 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   l.speed_m_per_s = limits.positive("speed_m_per_s", 0, true);
   l.cutoff_tension_n = limits.positive("cutoff_tension_n", 0, true);
   l.hard_limit_tension_n = limits.positive("hard_limit_tension_n", 0, true);
-  if (!(l.max_rest_length_m > l.min_rest_length_m)) limits.fail("max_rest_length_m", "must be above min_rest_length_m");
-  if (!(l.hard_limit_tension_n >= l.cutoff_tension_n)) {
-    limits.fail("hard_limit_tension_n", "must be at least cutoff_tension_n");
+  if (const core::LimitsError e = core::validate(l); e != core::LimitsError::none) {
+    limits.fail(core::field_of(e), core::describe(e));
   }
+}
+
+void parse_loop(const Reader& top, EndcapAppConfig& c) {
+  if (!top.has("loop")) return;
+  const Reader loop = top.object("loop");
+  loop.only({"rate_hz", "mode"});
+  c.loop_rate_hz = loop.positive("rate_hz", 1000.0);
+  if (c.loop_rate_hz > 10'000.0) loop.fail("rate_hz", "must be at most 10000");
+  if (loop.has("mode")) {
+    const std::string mode = loop.string("mode");
+    if (mode == "realtime") {
+      c.mode = LoopMode::realtime;
+    } else if (mode == "lockstep") {
+      c.mode = LoopMode::lockstep;
+    } else {
+      loop.fail("mode", "must be \"realtime\" or \"lockstep\", not \"" + mode + "\"");
+    }
+  }
+}
+
+}  // namespace
+
+const char* to_string(LoopMode mode) { return mode == LoopMode::lockstep ? "lockstep" : "realtime"; }
+
+std::int64_t EndcapAppConfig::period_ns() const { return static_cast<std::int64_t>(std::llround(1e9 / loop_rate_hz)); }
+
+EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source) {
+  const json doc = format::parse_json<ConfigError>(json_text, source);
+  const Reader top(doc, source, "");
+  top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
+            "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore"});
+  if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
+
+  EndcapAppConfig c;
+  if (endcap_id < 0 || endcap_id > 11)
+    throw ConfigError("--id: end cap id must be 0..11, not " + std::to_string(endcap_id));
+  c.endcap_id = endcap_id;
+
+  c.bus = top.string("bus");
+  CanBusSpec spec;
+  std::string error;
+  if (!parse_can_bus_spec(c.bus, spec, error)) top.fail("bus", error);
+
+  parse_nodes(top, c);
+  parse_spool_and_limits(top, c);
+  const core::MotorLimits& l = c.limits;
 
   c.initial_rest_length_m = top.positive("initial_rest_length_m", 0, true);
   if (c.initial_rest_length_m < l.min_rest_length_m || c.initial_rest_length_m > l.max_rest_length_m) {
@@ -154,22 +181,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   }
   c.storage_dir = top.string("storage_dir");
 
-  if (top.has("loop")) {
-    const Reader loop = top.object("loop");
-    loop.only({"rate_hz", "mode"});
-    c.loop_rate_hz = loop.positive("rate_hz", 1000.0);
-    if (c.loop_rate_hz > 10'000.0) loop.fail("rate_hz", "must be at most 10000");
-    if (loop.has("mode")) {
-      const std::string mode = loop.string("mode");
-      if (mode == "realtime") {
-        c.mode = LoopMode::realtime;
-      } else if (mode == "lockstep") {
-        c.mode = LoopMode::lockstep;
-      } else {
-        loop.fail("mode", "must be \"realtime\" or \"lockstep\", not \"" + mode + "\"");
-      }
-    }
-  }
+  parse_loop(top, c);
   parse_timeouts(top, c);
   parse_abort_connection(top, c);
   c.start_on_boot = top.boolean("start_on_boot", false);

@@ -3,6 +3,7 @@
 // Fixed capacities and per-motor limits of the control core. The core has no heap
 // after construction, so every table it holds has a compile-time bound.
 #include <cstddef>
+#include <cstdint>
 
 namespace tensegrity::core {
 
@@ -18,5 +19,19 @@ struct MotorLimits {
   // Above this the end cap faults and holds until the fault is cleared.
   double hard_limit_tension_n = 500.0;
 };
+
+enum class LimitsError : std::uint8_t {
+  none = 0,
+  not_positive,             // a limit is zero, negative or not finite
+  empty_rest_length_range,  // max_rest_length_m is not above min_rest_length_m
+  hard_limit_below_cutoff,  // the end cap would fault before the motor stops pulling
+};
+
+// The one check of a set of limits, for the end cap's config and the robot files.
+LimitsError validate(const MotorLimits& limits) noexcept;
+// Static text for errors, naming the fields by their MotorLimits names.
+const char* describe(LimitsError error) noexcept;
+// The MotorLimits field an error is reported at ("max_rest_length_m", ...).
+const char* field_of(LimitsError error) noexcept;
 
 }  // namespace tensegrity::core

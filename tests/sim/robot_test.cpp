@@ -126,7 +126,7 @@ TEST(Robot, OtherBadFieldsNamed) {
   EXPECT_THAT(error_of(doc), HasSubstr("format: expected"));
   doc = superball_json();
   doc["cable"]["max_rest_length_m"] = 0.5;
-  EXPECT_THAT(error_of(doc), HasSubstr("cable.max_rest_length_m: must be greater than min_rest_length_m"));
+  EXPECT_THAT(error_of(doc), HasSubstr("cable.max_rest_length_m: must be above min_rest_length_m"));
   doc = superball_json();
   doc["cable"]["hard_limit_tension_n"] = 300.0;
   EXPECT_THAT(error_of(doc), HasSubstr("cable.hard_limit_tension_n"));
@@ -180,6 +180,18 @@ TEST(Robot, RodContactIsOptionalAndValidated) {
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.rod_contact: must be true or false"));
   doc["strut"]["rod_contact"] = 1;
   EXPECT_THAT(error_of(doc), HasSubstr("strut.rod_contact: must be true or false"));
+}
+
+TEST(Robot, StartPoseIsOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(plain.start_pose, Robot::StartPose::face_down);
+  doc["start"]["pose"] = "description";
+  const Robot described = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(described.start_pose, Robot::StartPose::description);
+  EXPECT_NE(described.hash, plain.hash);
+  doc["start"]["pose"] = "upright";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: start.pose: must be \"face_down\" or \"description\""));
 }
 
 TEST(Robot, MissingFileIsAClearError) {
