@@ -181,31 +181,41 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
       }
       break;
     case BringUpStep::enable:
-      for (std::size_t i = 0; i < drive_count_; ++i) {
-        const Cia402State state = drives_[i].status.state;
-        if (state == Cia402State::fault || state == Cia402State::fault_reaction_active) {
-          request_power(PowerRequest::disabled);
-          b.drive_index = i;
-          return fail_bring_up("drive entered fault", now_ns);
-        }
-      }
-      if (all_drives([&](std::size_t i) { return drives_[i].status.state == Cia402State::operation_enabled; })) {
-        enter_step(BringUpStep::done, now_ns);
-        return;
-      }
+      if (step_enable(now_ns)) return;
       break;
     default: return;
   }
-  if (now_ns - b.step_started_ns > config_.bring_up_step_timeout_ns) {
-    request_power(PowerRequest::disabled);
-    if (b.step == BringUpStep::enable) {  // name the first drive that did not come up
-      while (b.drive_index + 1 < drive_count_ &&
-             drives_[b.drive_index].status.state == Cia402State::operation_enabled) {
-        ++b.drive_index;
-      }
+  fail_step_after_timeout(now_ns);
+}
+
+// True when the enable step ended: every drive operation enabled, or one in fault.
+bool CanopenMaster::step_enable(std::int64_t now_ns) {
+  BringUp& b = bring_up_;
+  bool all_enabled = true;
+  for (std::size_t i = 0; i < drive_count_; ++i) {
+    const Cia402State state = drives_[i].status.state;
+    if (state == Cia402State::fault || state == Cia402State::fault_reaction_active) {
+      request_power(PowerRequest::disabled);
+      b.drive_index = i;
+      fail_bring_up("drive entered fault", now_ns);
+      return true;
     }
-    fail_bring_up(b.step == BringUpStep::wait_boot ? "no heartbeat from a node (timeout)" : "timeout", now_ns);
+    all_enabled = all_enabled && state == Cia402State::operation_enabled;
   }
+  if (all_enabled) enter_step(BringUpStep::done, now_ns);
+  return all_enabled;
+}
+
+void CanopenMaster::fail_step_after_timeout(std::int64_t now_ns) {
+  BringUp& b = bring_up_;
+  if (now_ns - b.step_started_ns <= config_.bring_up_step_timeout_ns) return;
+  request_power(PowerRequest::disabled);
+  if (b.step == BringUpStep::enable) {  // name the first drive that did not come up
+    while (b.drive_index + 1 < drive_count_ && drives_[b.drive_index].status.state == Cia402State::operation_enabled) {
+      ++b.drive_index;
+    }
+  }
+  fail_bring_up(b.step == BringUpStep::wait_boot ? "no heartbeat from a node (timeout)" : "timeout", now_ns);
 }
 
 }  // namespace tensegrity::fw::canopen

@@ -242,6 +242,8 @@ class CanopenMaster {
 
   void produce_heartbeat(std::int64_t now_ns);
   void step_bring_up(std::int64_t now_ns);
+  bool step_enable(std::int64_t now_ns);
+  void fail_step_after_timeout(std::int64_t now_ns);
   bool step_drive_sdo(std::int64_t now_ns, BringUpStep& next);
   void enter_step(BringUpStep step, std::int64_t now_ns);
   void fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t detail = 0);
