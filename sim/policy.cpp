@@ -205,19 +205,20 @@ void save_policy(const std::filesystem::path& path, const Policy& policy) {
 }
 
 core::EndcapTable endcap_table(const Policy& policy, const Robot& robot, int endcap) {
-  core::EndcapTable table;
-  const std::vector<int> owned = robot.cables_of(endcap);
-  if (owned.size() > core::kMaxMotorsPerEndcap) {
-    throw PolicyError("end cap " + std::to_string(endcap) + " owns more cables than the core supports");
+  // The end cap's own rule (format::endcap_table_of), so that the simulator, the HIL
+  // and the upload give an end cap the table it would take from the file itself.
+  format::PolicyDocument doc;
+  doc.robot = policy.robot;
+  doc.period_s = policy.period_s;
+  doc.complexity = policy.complexity;
+  doc.cables.reserve(policy.cables.size());
+  for (const CablePolicy& c : policy.cables) doc.cables.push_back({c.cable, c.owner, c.rest_lengths_m});
+  const auto motor_count = static_cast<std::uint32_t>(robot.cables_of(endcap).size());
+  try {
+    return format::endcap_table_of(doc, endcap, motor_count, robot.motor, "policy");
+  } catch (const format::PolicyFormatError& e) {
+    throw PolicyError(e.what());
   }
-  table.motor_count = static_cast<std::uint32_t>(owned.size());
-  table.complexity = static_cast<std::uint32_t>(policy.complexity);
-  table.period_s = policy.period_s;
-  for (std::size_t k = 0; k < owned.size(); ++k) {
-    const auto& values = policy.cables.at(owned[k]).rest_lengths_m;
-    for (std::size_t j = 0; j < values.size(); ++j) table.rest_length_m[k][j] = values[j];
-  }
-  return table;
 }
 
 }  // namespace tensegrity::sim

@@ -71,7 +71,8 @@ std::filesystem::path robot_path_for_policy(const std::filesystem::path& policy_
 // Writes to a temporary file beside `path`, then renames: never a half-written policy.
 void save_policy(const std::filesystem::path& path, const Policy& policy);
 
-// The share of end cap `endcap`: its cables in increasing index, as the core plays it.
+// The share of end cap `endcap`: its cables in increasing index, as the core plays it,
+// by the end cap's own rule (format::endcap_table_of) and checked by its limits.
 core::EndcapTable endcap_table(const Policy& policy, const Robot& robot, int endcap);
 
 }  // namespace tensegrity::sim

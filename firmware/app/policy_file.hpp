@@ -2,8 +2,8 @@
 // This end cap's share of a policy file ("tensegrity-policy/1", written by the
 // simulator: sim/policy.hpp), read by the one policy-format parser every process
 // uses (format/policy_format.hpp). The share is the cables whose "owner" is this
-// end cap, in increasing cable index: the same rule as sim::endcap_table, so motor
-// m plays the same column everywhere.
+// end cap, in increasing cable index (format::endcap_table_of, which the simulator's
+// sim::endcap_table calls too), so motor m plays the same column everywhere.
 #pragma once
 
 #include <filesystem>
