@@ -76,7 +76,8 @@ const ModelState& settled_state(const Robot& robot, double dt_s) {
   auto& slot = cache[{robot.hash + robot.name, dt_s}];
   if (!slot) {
     Model model(robot, dt_s);
-    model.restore(dropped(robot, dt_s, face_down_pose(robot)));
+    const bool face_down = robot.start_pose == Robot::StartPose::face_down;
+    model.restore(dropped(robot, dt_s, face_down ? face_down_pose(robot) : robot.nodes_m));
     const std::vector<double> hold(robot.cables.size(), robot.initial_rest_length_m);
     const auto steps = static_cast<std::int64_t>(std::llround(robot.settle_s / dt_s));
     for (std::int64_t i = 0; i < steps; ++i) model.step(hold);

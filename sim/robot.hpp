@@ -61,6 +61,11 @@ struct Robot {
   // Start: the lowest end cap's surface this far above the ground, then settle.
   double start_clearance_m = 0.05;
   double settle_s = 4.0;
+  // The pose the settled start drops: a closed cable triangle turned face down (the
+  // project's default), or the description's own pose, as the Bullet cross-check of
+  // issue 14 started (dropped, 2 s, then scored from wherever it came to lie).
+  enum class StartPose { face_down, description };
+  StartPose start_pose = StartPose::face_down;
   // FNV-1a 64 of the canonical JSON, as 16 hex digits: names the exact model a
   // policy was learned on.
   std::string hash;

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -109,6 +111,31 @@ TEST(Episode, BitIdenticalAcrossRuns) {
   EXPECT_EQ(ra.mean_tension_n, rb.mean_tension_n);
   EXPECT_EQ(ra.motor_energy_j, rb.motor_energy_j);
   EXPECT_GT(ra.distance_m, 0.01);  // it does move
+}
+
+// start.pose "description" drops the description's own pose; settled for 0 s it is
+// the drop start exactly, and settled for a while it comes to rest from there.
+TEST(Episode, DescriptionPoseStartDropsTheDescriptionsPose) {
+  Robot robot = superball();
+  robot.start_pose = Robot::StartPose::description;
+  robot.settle_s = 0.0;
+  robot.hash += "-description-0s";  // the settled start is cached by hash
+  const ModelState& settled = settled_state(robot, robot.time_step_s);
+  const ModelState dropped = drop_state(robot, robot.time_step_s);
+  EXPECT_EQ(settled.body, dropped.body);
+  robot.settle_s = 2.0;
+  robot.hash += "-2s";
+  const ModelState& rested = settled_state(robot, robot.time_step_s);
+  const ModelState& face_down = settled_state(superball(), robot.time_step_s);
+  ASSERT_EQ(rested.body.size(), dropped.body.size());
+  double lowest_before = 1e9, lowest_after = 1e9, apart = 0.0;
+  for (std::size_t s = 0; s < dropped.body.size(); s += 13) {  // pos(3) quat(4) linvel(3) angvel(3)
+    lowest_before = std::min(lowest_before, dropped.body[s + 2]);
+    lowest_after = std::min(lowest_after, rested.body[s + 2]);
+    apart = std::max(apart, std::fabs(rested.body[s + 2] - face_down.body[s + 2]));
+  }
+  EXPECT_LT(lowest_after, lowest_before) << "2 s after the drop the struts are lower";
+  EXPECT_GT(apart, 1e-3) << "not the face-down start";
 }
 
 TEST(Episode, TelemetryCsvHasOneRowPerRecordedStep) {
