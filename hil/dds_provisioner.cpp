@@ -28,9 +28,6 @@ namespace {
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
 
-// Seconds from a config to nanoseconds: the one rounding conversion, core's.
-std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
-
 // Threads of this provisioner talk DDS; they must not inherit the emulator's
 // SCHED_FIFO (they would compete with the stepper they wait for).
 void normal_priority() {
@@ -128,7 +125,8 @@ double DdsProvisioner::upload_policy(const fw::comms::PolicyIdentity& identity, 
 // Real time: an end cap armed early in the boot may have latched a sensor
 // timeout while the emulator was busy starting the others. Cleared, and said.
 void DdsProvisioner::clear_faults_or_fail(std::uint16_t mask) {
-  if (clear_faults_before_start(mask, ground::Station::now_ns() + to_ns(config_.command_timeout_s))) return;
+  if (clear_faults_before_start(mask, ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s)))
+    return;
   std::string why;
   const auto status = station_->snapshot();
   for (int e = 0; e < robot_.endcap_count(); ++e) {
@@ -155,7 +153,7 @@ std::int64_t DdsProvisioner::place_start(StartHandshake& handshake, std::string&
   char in[48];
   std::snprintf(in, sizeof in, "in %.2f s", config_.realtime_lead_s);
   how = in;
-  return ground::Station::now_ns() + to_ns(config_.realtime_lead_s);
+  return ground::Station::now_ns() + core::seconds_to_ns(config_.realtime_lead_s);
 }
 
 void DdsProvisioner::send_start(std::uint16_t mask, std::int64_t start_ns) {
@@ -187,7 +185,7 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
   const int n = robot_.endcap_count();
   const auto mask = static_cast<std::uint16_t>((1U << n) - 1U);
   const std::int64_t t0 = ground::Station::now_ns();
-  await_endcaps(mask, t0 + to_ns(config_.discovery_timeout_s));
+  await_endcaps(mask, t0 + core::seconds_to_ns(config_.discovery_timeout_s));
   const std::int64_t t_found = ground::Station::now_ns();
 
   fw::comms::PolicyIdentity identity;
@@ -200,7 +198,7 @@ void DdsProvisioner::deliver(StartHandshake& handshake) {
 
   // Once every clock is known well enough to place the start.
   const double settle_rt_ms =
-      settle_time_sync(mask, ground::Station::now_ns() + to_ns(config_.sync_settle_timeout_s)) * 1e3;
+      settle_time_sync(mask, ground::Station::now_ns() + core::seconds_to_ns(config_.sync_settle_timeout_s)) * 1e3;
   std::string how;
   const std::int64_t start_ns = place_start(handshake, how);
   send_start(mask, start_ns);
@@ -333,7 +331,7 @@ void DdsProvisioner::supervise() {
         // Latched while coming back (a sample late while the emulator served the
         // others): the same clear-fault as before the run's start.
         clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
-                                  ground::Station::now_ns() + to_ns(config_.command_timeout_s));
+                                  ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s));
         continue;
       }
       const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
@@ -341,8 +339,9 @@ void DdsProvisioner::supervise() {
                          s.telemetry.fault() == 0;
       if (!ready) continue;
       // Its phase is as good as its clock: give the time sync a moment.
-      const double round_trip_s = settle_time_sync(
-          static_cast<std::uint16_t>(1U << e), ground::Station::now_ns() + to_ns(config_.rejoin_sync_settle_timeout_s));
+      const double round_trip_s =
+          settle_time_sync(static_cast<std::uint16_t>(1U << e),
+                           ground::Station::now_ns() + core::seconds_to_ns(config_.rejoin_sync_settle_timeout_s));
       ground::CommandOptions co;
       co.endcap_mask = static_cast<std::uint16_t>(1U << e);
       co.timeout_s = config_.command_timeout_s;

@@ -8,11 +8,6 @@
 #include "firmware/core/table.hpp"
 
 namespace tensegrity::fw::app {
-namespace {
-// Seconds from a config to nanoseconds: the one rounding conversion, core's.
-std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
-}  // namespace
-
 LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   LoopSettings s;
   s.core.motor_count = c.motor_count;
@@ -23,17 +18,17 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   for (std::uint32_t i = 1; i < c.motor_count; ++i) s.master.extra_drive_node_ids[i - 1] = c.drive_node_ids[i];
   s.master.load_cell_node_id = c.load_cell_node_id;
   s.master.use_load_cell = c.use_load_cell;
-  s.master.drive_heartbeat_timeout_ns = to_ns(c.drive_heartbeat_timeout_s);
-  s.master.load_cell_heartbeat_timeout_ns = to_ns(c.load_cell_heartbeat_timeout_s);
+  s.master.drive_heartbeat_timeout_ns = core::seconds_to_ns(c.drive_heartbeat_timeout_s);
+  s.master.load_cell_heartbeat_timeout_ns = core::seconds_to_ns(c.load_cell_heartbeat_timeout_s);
   s.master.spool = c.spool();
   s.master.master_node_id = c.endcap_node_id;
-  s.master.producer_heartbeat_period_ns = to_ns(c.endcap_heartbeat_s);
+  s.master.producer_heartbeat_period_ns = core::seconds_to_ns(c.endcap_heartbeat_s);
   s.master.drive_consumer_heartbeat_ms = static_cast<std::uint16_t>(std::llround(c.drive_consumer_heartbeat_s * 1e3));
   s.master.drive_abort_connection = c.drive_abort_connection;
-  s.safety.drive_position_timeout_ns = to_ns(c.drive_position_timeout_s);
+  s.safety.drive_position_timeout_ns = core::seconds_to_ns(c.drive_position_timeout_s);
   s.safety.motor_count = c.motor_count;
   s.safety.use_load_cell = c.use_load_cell;
-  s.safety.load_cell_sample_timeout_ns = to_ns(c.load_cell_sample_timeout_s);
+  s.safety.load_cell_sample_timeout_ns = core::seconds_to_ns(c.load_cell_sample_timeout_s);
   s.mode = c.mode;
   s.period_ns = c.period_ns();
   s.start_on_boot = c.start_on_boot;

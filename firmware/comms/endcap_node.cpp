@@ -30,15 +30,13 @@ constexpr std::int64_t kInitialSyncSpacingNs = 25'000'000;
 // While unsynchronized the log says why, this often (a start is refused until then).
 constexpr std::int64_t kUnsyncedReportNs = 5'000'000'000;
 std::int64_t period_ns(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
-// Seconds from a config to nanoseconds: the one rounding conversion, core's.
-std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 }  // namespace
 
 EndcapNode::EndcapNode(const EndcapNodeConfig& config, Clock& clock, app::PolicyStore* store)
     : config_(config),
       clock_(clock),
       store_(store),
-      gate_(config.endcap_id, msgs::kFormatVersion, to_ns(config.command_max_age_s)),
+      gate_(config.endcap_id, msgs::kFormatVersion, core::seconds_to_ns(config.command_max_age_s)),
       start_mapper_(config.start_grid_ns),
       sync_(std::random_device{}() ^ (static_cast<std::uint64_t>(std::random_device{}()) << 32)) {
   config_.expect.endcap_id = config_.endcap_id;
@@ -199,7 +197,7 @@ void EndcapNode::service(std::int64_t now) {
   if (now >= next_sync_ns_) {
     send_time_sync_request();
     const bool burst = sync_sequence_ < kInitialSyncBurst;
-    next_sync_ns_ = now + (burst ? kInitialSyncSpacingNs : to_ns(config_.time_sync_interval_s));
+    next_sync_ns_ = now + (burst ? kInitialSyncSpacingNs : core::seconds_to_ns(config_.time_sync_interval_s));
   }
   if (now >= next_unsynced_report_ns_) {
     next_unsynced_report_ns_ = now + kUnsyncedReportNs;
