@@ -73,6 +73,22 @@ void BM_ModelStepRodContact(benchmark::State& state) {
 }
 BENCHMARK(BM_ModelStepRodContact);
 
+// The same settled robot in the Bullet engine (robot.engine "bullet").
+void BM_ModelStepBullet(benchmark::State& state) {
+  Robot robot = load_robot(default_robot_path());
+  robot.engine = Robot::PhysicsEngine::bullet;
+  robot.hash += "-bullet";  // settled_state caches by hash
+  Model model(robot, 0.001);
+  model.restore(settled_state(robot, 0.001));
+  std::vector<double> preferred(robot.cables.size(), robot.initial_rest_length_m);
+  for (auto _ : state) {
+    model.step(preferred);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ModelStepBullet);
+
 void BM_BenchmarkEpisode10s(benchmark::State& state) {
   const Robot robot = load_robot(default_robot_path());
   EpisodeOptions options;

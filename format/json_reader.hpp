@@ -100,6 +100,20 @@ class JsonReader {
     }
     return v.get<std::string>();
   }
+  // One of `options` (absent: `fallback`), as its index; anything else is refused
+  // with the options spelt out.
+  std::size_t choice(const char* key, std::initializer_list<const char*> options, std::size_t fallback) const {
+    if (!has(key)) return fallback;
+    const std::string got = string(key, true);
+    std::size_t i = 0;
+    std::string listed;
+    for (const char* option : options) {
+      if (got == option) return i;
+      listed += (i == 0 ? "" : (i + 1 == options.size() ? " or " : ", ")) + ("\"" + std::string(option) + "\"");
+      ++i;
+    }
+    fail(key, "must be " + listed + " (got \"" + got + "\")");
+  }
   bool boolean(const char* key, bool fallback) const {
     if (!has(key)) return fallback;
     if (!j_.at(key).is_boolean()) fail(key, "must be true or false");

@@ -1,59 +1,22 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/model.hpp"
 
-#include <ode/ode.h>
-
 #include <Eigen/Geometry>
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
-#include <mutex>
 #include <string>
 
 #include "firmware/core/rate_limit.hpp"
-#include "sim/model_ode.hpp"
 #include "sim/strut_frame.hpp"
 
 namespace tensegrity::sim {
-namespace {
 
-// ODE's debug checks call abort() after the handler returns; throwing instead turns
-// a diverged world into an error the episode can report, not a dead process.
-[[noreturn]] void ode_fault(int code, const char* message, va_list args) {
-  char text[512];
-  std::vsnprintf(text, sizeof text, message, args);
-  throw ModelDiverged("ODE error " + std::to_string(code) + ": " + text);
+std::unique_ptr<Engine> make_engine(const Robot& robot, double dt_s) {
+  return robot.engine == Robot::PhysicsEngine::bullet ? make_bullet_engine(robot, dt_s) : make_ode_engine(robot, dt_s);
 }
 
-void init_ode_for_this_thread() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    dInitODE2(0);
-    dSetErrorHandler(ode_fault);
-    dSetDebugHandler(ode_fault);
-  });
-  thread_local const bool allocated = [] {
-    dAllocateODEDataForThread(dAllocateMaskAll);
-    return true;
-  }();
-  (void)allocated;
-}
-
-using ode_detail::axis_of;
-using ode_detail::rotation_of;
-using ode_detail::vec;
-
-}  // namespace
-
-Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_(std::make_unique<Ode>()) {
+Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
-  init_ode_for_this_thread();
-  ode_->world = dWorldCreate();
-  ode_->threading = dThreadingAllocateSelfThreadedImplementation();
-  dWorldSetStepThreadingImplementation(ode_->world, dThreadingImplementationGetFunctions(ode_->threading),
-                                       ode_->threading);
-  ode_->contacts = dJointGroupCreate(0);
-  dWorldSetAutoDisableFlag(ode_->world, 0);
+  engine_ = make_engine(robot_, dt_s);
   set_gravity_enabled(true);
 
   const int nodes = robot_.node_count();
@@ -67,15 +30,9 @@ Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s), ode_
     strut_of_node_[strut.node_b] = static_cast<int>(s);
     end_sign_of_node_[strut.node_a] = -1.0;
     end_sign_of_node_[strut.node_b] = +1.0;
-
-    dBodyID body = dBodyCreate(ode_->world);
-    dMass mass;
-    // A capsule whose end spheres are centred on the end caps.
-    dMassSetCapsuleTotal(&mass, robot_.strut_mass_kg, 3, robot_.strut_radius_m, length);
-    dBodySetMass(body, &mass);
-    ode_->bodies.push_back(body);
-    ode_->inertia_diag.emplace_back(mass.I[0], mass.I[5], mass.I[10]);
   }
+  body_.resize(robot_.struts.size());
+  overlaps_.reserve(robot_.struts.size() * (robot_.struts.size() - 1) / 2);
   const auto cables = static_cast<std::size_t>(robot_.cable_count());
   rest_length_m_.assign(cables, robot_.initial_rest_length_m);
   length_m_.assign(cables, 0.0);
@@ -115,7 +72,11 @@ void Model::init_surface_attachments() {
   }
 }
 
-void Model::set_gravity_enabled(bool on) { dWorldSetGravity(ode_->world, 0, 0, on ? -robot_.gravity_m_per_s2 : 0.0); }
+void Model::set_gravity_enabled(bool on) { engine_->set_gravity(on ? robot_.gravity_m_per_s2 : 0.0); }
+
+void Model::pull_bodies() {
+  for (std::size_t s = 0; s < body_.size(); ++s) body_[s] = engine_->body(static_cast<int>(s));
+}
 
 void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
   for (std::size_t s = 0; s < robot_.struts.size(); ++s) {
@@ -127,13 +88,12 @@ void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
     const Eigen::Quaterniond q =
         surface_ ? Eigen::Quaterniond(strut_frame(nodes_m, robot_.struts[s].node_a, robot_.struts[s].node_b))
                  : Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), b - a);
-    dBodyID body = ode_->bodies[s];
-    dBodySetPosition(body, centre.x(), centre.y(), centre.z());
-    const dQuaternion dq = {q.w(), q.x(), q.y(), q.z()};
-    dBodySetQuaternion(body, dq);
-    dBodySetLinearVel(body, 0, 0, 0);
-    dBodySetAngularVel(body, 0, 0, 0);
+    BodyState state;
+    state.position_m = centre;
+    state.quaternion_wxyz = {q.w(), q.x(), q.y(), q.z()};
+    engine_->set_body(static_cast<int>(s), state);
   }
+  pull_bodies();
   std::fill(rest_length_m_.begin(), rest_length_m_.end(), robot_.initial_rest_length_m);
   std::fill(rest_rate_m_per_s_.begin(), rest_rate_m_per_s_.end(), 0.0);
   update_cable_geometry();
@@ -143,11 +103,11 @@ void Model::place(std::span<const Eigen::Vector3d> nodes_m) {
 
 ModelState Model::save() const {
   ModelState state;
-  for (dBodyID body : ode_->bodies) {
-    const dReal* p = dBodyGetPosition(body);
-    const dReal* q = dBodyGetQuaternion(body);
-    const dReal* v = dBodyGetLinearVel(body);
-    const dReal* w = dBodyGetAngularVel(body);
+  for (const BodyState& b : body_) {
+    const auto& p = b.position_m;
+    const auto& q = b.quaternion_wxyz;
+    const auto& v = b.velocity_m_per_s;
+    const auto& w = b.angular_velocity_rad_per_s;
     state.body.insert(state.body.end(), {p[0], p[1], p[2], q[0], q[1], q[2], q[3], v[0], v[1], v[2], w[0], w[1], w[2]});
   }
   state.rest_length_m = rest_length_m_;
@@ -156,18 +116,19 @@ ModelState Model::save() const {
 }
 
 void Model::restore(const ModelState& state) {
-  if (state.body.size() != ode_->bodies.size() * 13 || state.rest_length_m.size() != rest_length_m_.size()) {
+  if (state.body.size() != body_.size() * 13 || state.rest_length_m.size() != rest_length_m_.size()) {
     throw RobotError("model: snapshot does not match this robot");
   }
-  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+  for (std::size_t s = 0; s < body_.size(); ++s) {
     const double* b = &state.body[s * 13];
-    dBodyID body = ode_->bodies[s];
-    dBodySetPosition(body, b[0], b[1], b[2]);
-    const dQuaternion q = {b[3], b[4], b[5], b[6]};
-    dBodySetQuaternion(body, q);
-    dBodySetLinearVel(body, b[7], b[8], b[9]);
-    dBodySetAngularVel(body, b[10], b[11], b[12]);
+    BodyState body;
+    body.position_m = {b[0], b[1], b[2]};
+    body.quaternion_wxyz = {b[3], b[4], b[5], b[6]};
+    body.velocity_m_per_s = {b[7], b[8], b[9]};
+    body.angular_velocity_rad_per_s = {b[10], b[11], b[12]};
+    engine_->set_body(static_cast<int>(s), body);
   }
+  pull_bodies();
   rest_length_m_ = state.rest_length_m;
   tension_n_ = state.tension_n;
   diverged_ = false;
@@ -177,12 +138,11 @@ void Model::restore(const ModelState& state) {
 
 void Model::update_cable_geometry() {
   for (std::size_t node = 0; node < node_pos_.size(); ++node) {
-    const int s = strut_of_node_[node];
-    dBodyID body = ode_->bodies[s];
-    const Eigen::Vector3d r = (end_sign_of_node_[node] * half_length_m_[s]) * axis_of(dBodyGetRotation(body));
+    const BodyState& body = body_[strut_of_node_[node]];
+    const Eigen::Vector3d r = (end_sign_of_node_[node] * half_length_m_[strut_of_node_[node]]) * body.rotation.col(2);
     node_arm_[node] = r;
-    node_pos_[node] = vec(dBodyGetPosition(body)) + r;
-    node_vel_[node] = vec(dBodyGetLinearVel(body)) + vec(dBodyGetAngularVel(body)).cross(r);
+    node_pos_[node] = body.position_m + r;
+    node_vel_[node] = body.velocity_m_per_s + body.angular_velocity_rad_per_s.cross(r);
   }
   for (std::size_t m = 0; m < robot_.cables.size(); ++m) {
     const auto& cable = robot_.cables[m];
@@ -191,14 +151,14 @@ void Model::update_cable_geometry() {
     arm_a_[m] = node_arm_[cable.node_a];
     arm_b_[m] = node_arm_[cable.node_b];
     if (surface_) {
-      dBodyID body_a = ode_->bodies[strut_of_node_[cable.node_a]];
-      dBodyID body_b = ode_->bodies[strut_of_node_[cable.node_b]];
-      const Eigen::Vector3d off_a = rotation_of(dBodyGetRotation(body_a)) * local_a_[m];
-      const Eigen::Vector3d off_b = rotation_of(dBodyGetRotation(body_b)) * local_b_[m];
+      const BodyState& body_a = body_[strut_of_node_[cable.node_a]];
+      const BodyState& body_b = body_[strut_of_node_[cable.node_b]];
+      const Eigen::Vector3d off_a = body_a.rotation * local_a_[m];
+      const Eigen::Vector3d off_b = body_b.rotation * local_b_[m];
       arm_a_[m] += off_a;
       arm_b_[m] += off_b;
       d += off_b - off_a;
-      dv += vec(dBodyGetAngularVel(body_b)).cross(off_b) - vec(dBodyGetAngularVel(body_a)).cross(off_a);
+      dv += body_b.angular_velocity_rad_per_s.cross(off_b) - body_a.angular_velocity_rad_per_s.cross(off_a);
     }
     const double span = d.norm();
     const double length = surface_ ? span + inner_run_m_[m] : span;
@@ -231,51 +191,13 @@ void Model::apply_forces() {
     force_[sb] -= f;
     torque_[sb] -= arm_b_[m].cross(f);
   }
-  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
-    dBodyID body = ode_->bodies[s];
+  for (std::size_t s = 0; s < body_.size(); ++s) {
     if (damping_enabled_ && robot_.axial_damping_n_m_s > 0.0) {
-      const Eigen::Vector3d axis = axis_of(dBodyGetRotation(body));
-      const double spin = vec(dBodyGetAngularVel(body)).dot(axis);
+      const Eigen::Vector3d axis = body_[s].rotation.col(2);
+      const double spin = body_[s].angular_velocity_rad_per_s.dot(axis);
       torque_[s] -= (robot_.axial_damping_n_m_s * spin) * axis;
     }
-    dBodyAddForce(body, force_[s].x(), force_[s].y(), force_[s].z());
-    dBodyAddTorque(body, torque_[s].x(), torque_[s].y(), torque_[s].z());
-  }
-}
-
-void Model::add_ground_contacts() {
-  contact_count_ = 0;
-  ground_mask_ = 0;
-  if (!ground_enabled_) return;
-  // A capsule meets a plane only with its end spheres, so two sphere tests per strut
-  // replace ODE's broad phase (which is also not thread-safe in Debian's build).
-  const double r = robot_.strut_radius_m;
-  const double kp = robot_.contact_stiffness_n_per_m;
-  const double kd = robot_.contact_damping_n_s_per_m;
-  const double h = dt_s_;
-  dContact contact{};
-  contact.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
-  if (robot_.ground_restitution > 0.0) {
-    contact.surface.mode |= dContactBounce;
-    contact.surface.bounce = robot_.ground_restitution;
-  }
-  contact.surface.mu = robot_.ground_friction;
-  contact.surface.soft_erp = h * kp / (h * kp + kd);
-  contact.surface.soft_cfm = 1.0 / (h * kp + kd);
-  contact.geom.normal[0] = 0;
-  contact.geom.normal[1] = 0;
-  contact.geom.normal[2] = 1;
-  for (std::size_t node = 0; node < node_pos_.size(); ++node) {
-    const double depth = r - node_pos_[node].z();
-    if (depth <= 0.0) continue;
-    contact.geom.pos[0] = node_pos_[node].x();
-    contact.geom.pos[1] = node_pos_[node].y();
-    contact.geom.pos[2] = node_pos_[node].z() - r;
-    contact.geom.depth = depth;
-    dJointID joint = dJointCreateContact(ode_->world, ode_->contacts, &contact);
-    dJointAttach(joint, ode_->bodies[strut_of_node_[node]], nullptr);
-    ++contact_count_;
-    ground_mask_ |= std::uint32_t{1} << node;
+    engine_->add_force_torque(static_cast<int>(s), force_[s], torque_[s]);
   }
 }
 
@@ -293,16 +215,28 @@ void Model::step(std::span<const double> preferred_rest_length_m) {
   update_cable_geometry();
   apply_forces();
   if (!forces_sane()) {
-    // Stepping on would hand ODE non-finite numbers; stop here and say so.
+    // Stepping on would hand the engine non-finite numbers; stop here and say so.
     diverged_ = true;
-    dJointGroupEmpty(ode_->contacts);
+    engine_->discard_step();
     return;
   }
-  add_ground_contacts();
-  strut_contact_count_ = 0;
-  add_strut_contacts();
-  dWorldStep(ode_->world, dt_s_);
-  dJointGroupEmpty(ode_->contacts);
+  measure_strut_gaps();
+  const ContactReport contacts = engine_->step(dt_s_, StepInput{node_pos_, strut_of_node_, overlaps_, ground_enabled_});
+  contact_count_ = contacts.ground_contacts;
+  ground_mask_ = contacts.ground_mask;
+  strut_contact_count_ = contacts.strut_contacts;
+  pull_bodies();
+  if (robot_.zero_axial_spin) remove_axial_spin();
+}
+
+void Model::remove_axial_spin() {
+  for (std::size_t s = 0; s < body_.size(); ++s) {
+    const BodyState& body = body_[s];
+    const Eigen::Vector3d axis = body.rotation.col(2);
+    const Eigen::Vector3d& w = body.angular_velocity_rad_per_s;
+    engine_->set_velocity(static_cast<int>(s), body.velocity_m_per_s, w - w.dot(axis) * axis);
+  }
+  pull_bodies();
 }
 
 bool Model::forces_sane() const {
@@ -310,10 +244,10 @@ bool Model::forces_sane() const {
   // integration has diverged, well before the numbers overflow.
   constexpr double kMaxSpeed = 1e3;
   double sum = 0.0;
-  for (std::size_t s = 0; s < ode_->bodies.size(); ++s) {
+  for (std::size_t s = 0; s < body_.size(); ++s) {
     sum += force_[s].sum() + torque_[s].sum();
-    const Eigen::Vector3d v = vec(dBodyGetLinearVel(ode_->bodies[s]));
-    const Eigen::Vector3d w = vec(dBodyGetAngularVel(ode_->bodies[s]));
+    const Eigen::Vector3d& v = body_[s].velocity_m_per_s;
+    const Eigen::Vector3d& w = body_[s].angular_velocity_rad_per_s;
     if (!(v.squaredNorm() < kMaxSpeed * kMaxSpeed) || !(w.squaredNorm() < 1e2 * kMaxSpeed * kMaxSpeed)) return false;
   }
   return std::isfinite(sum);

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The robot in ODE: struts as capsule bodies, cables as one-sided spring-dampers
-// between strut end points whose rest lengths motors drive, a ground plane, and
-// (robot.rod_contact) capsules that collide with each other.
+// The robot: struts as capsule bodies, cables as one-sided spring-dampers between
+// strut end points whose rest lengths motors drive, a ground plane, and
+// (robot.rod_contact) capsules that collide with each other. The bodies live in the
+// robot's rigid-body engine (sim/engine.hpp: ODE by default, or Bullet); cable
+// forces, spin damping and every measure are computed here, the same for both.
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>
@@ -11,11 +13,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "sim/engine.hpp"
 #include "sim/robot.hpp"
 
 namespace tensegrity::sim {
 
-// Thrown when ODE reports an internal error (a diverged world).
+// Thrown when the engine reports an internal error (a diverged world).
 class ModelDiverged : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
@@ -83,18 +86,22 @@ class Model {
   void set_damping_enabled(bool on) { damping_enabled_ = on; }
 
  private:
-  struct Ode;
+  // Reads every body from the engine into body_ (after place, restore, step).
+  void pull_bodies();
   void update_cable_geometry();
   void apply_forces();
-  void add_ground_contacts();
-  void add_strut_contacts();  // model_strut_contact.cpp
+  // Closest approach of every pair of struts; overlaps_ when they collide.
+  void measure_strut_gaps();  // model_strut_contact.cpp
+  void remove_axial_spin();
   // Surface attachment: body-frame offsets of every cable end from its end cap centre.
   void init_surface_attachments();
   bool forces_sane() const;
 
   Robot robot_;
   double dt_s_;
-  std::unique_ptr<Ode> ode_;
+  std::unique_ptr<Engine> engine_;
+  std::vector<BodyState> body_;  // per strut, as the engine last reported it
+  std::vector<StrutOverlap> overlaps_;
   // Per strut: half length, and per node the strut and the sign of its end.
   std::vector<double> half_length_m_;
   std::vector<int> strut_of_node_;

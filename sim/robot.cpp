@@ -66,16 +66,9 @@ void parse_strut(const Reader& r, Robot& robot) {
   if (robot.strut_mass_kg > kMaxStrutMassKg) strut.fail("mass_kg", "must be at most 1000 kg");
   if (robot.strut_radius_m > kMaxStrutRadiusM) strut.fail("radius_m", "must be at most 1 m");
   robot.axial_damping_n_m_s = strut.non_negative("axial_damping_n_m_s", 0.0);
-  if (strut.has("cable_attachment")) {
-    const std::string where = strut.string("cable_attachment", true);
-    if (where == "axis") {
-      robot.cable_attachment = CableAttachment::axis;
-    } else if (where == "surface") {
-      robot.cable_attachment = CableAttachment::surface;
-    } else {
-      strut.fail("cable_attachment", "must be \"axis\" or \"surface\" (got \"" + where + "\")");
-    }
-  }
+  robot.cable_attachment =
+      strut.choice("cable_attachment", {"axis", "surface"}, 0) == 0 ? CableAttachment::axis : CableAttachment::surface;
+  robot.zero_axial_spin = strut.choice("axial_spin", {"free", "zeroed"}, 0) == 1;
   robot.rod_contact = strut.boolean("rod_contact", false);
 }
 
@@ -162,16 +155,8 @@ void parse_ground_and_start(const Reader& r, Robot& robot) {
   const Reader start = r.object("start");
   robot.start_clearance_m = start.non_negative("clearance_m");
   robot.settle_s = start.non_negative("settle_s");
-  if (start.has("pose")) {
-    const std::string pose = start.string("pose");
-    if (pose == "face_down") {
-      robot.start_pose = Robot::StartPose::face_down;
-    } else if (pose == "description") {
-      robot.start_pose = Robot::StartPose::description;
-    } else {
-      start.fail("pose", "must be \"face_down\" or \"description\", not \"" + pose + "\"");
-    }
-  }
+  robot.start_pose = start.choice("pose", {"face_down", "description"}, 0) == 0 ? Robot::StartPose::face_down
+                                                                                : Robot::StartPose::description;
 }
 
 }  // namespace
@@ -205,6 +190,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   robot.name = r.string("name");
   robot.gravity_m_per_s2 = r.non_negative("gravity_m_per_s2");
   robot.time_step_s = r.positive("time_step_s", 0.0, true);
+  robot.engine =
+      r.choice("engine", {"ode", "bullet"}, 0) == 0 ? Robot::PhysicsEngine::ode : Robot::PhysicsEngine::bullet;
   if (robot.time_step_s > 0.01) r.fail("time_step_s", "must be at most 0.01 s (the model is unstable above)");
   parse_nodes(r, robot);
   parse_strut(r, robot);

@@ -50,10 +50,18 @@ struct Robot {
   // strut.rod_contact: struts collide with each other as capsules (as rigid bodies do
   // in NTRT's Bullet world). Off, they pass through each other (docs/model.md).
   bool rod_contact = false;
+  // strut.axial_spin "zeroed": after every step a strut's spin about its own axis is
+  // removed, as issue 14's Bullet cross-check did; "free" (default) leaves it to the
+  // cables, the ground and axial_damping_n_m_s.
+  bool zero_axial_spin = false;
   double initial_rest_length_m = 0.0;
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;
   double time_step_s = 0.001;
+  // engine: the rigid-body engine under the model (sim/engine.hpp), "ode" (default)
+  // or "bullet", to tell the model's physics from its engine's.
+  enum class PhysicsEngine { ode, bullet };
+  PhysicsEngine engine = PhysicsEngine::ode;
   double ground_friction = 1.0;
   double ground_restitution = 0.0;
   double contact_stiffness_n_per_m = 5e5;

@@ -194,6 +194,28 @@ TEST(Robot, StartPoseIsOptionalAndValidated) {
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: start.pose: must be \"face_down\" or \"description\""));
 }
 
+TEST(Robot, EngineAndAxialSpinAreOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(plain.engine, Robot::PhysicsEngine::ode);
+  EXPECT_FALSE(plain.zero_axial_spin);
+  doc["engine"] = "bullet";
+  doc["strut"]["axial_spin"] = "zeroed";
+  const Robot bullet = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(bullet.engine, Robot::PhysicsEngine::bullet);
+  EXPECT_TRUE(bullet.zero_axial_spin);
+  EXPECT_NE(bullet.hash, plain.hash);
+  doc["strut"]["axial_spin"] = "free";
+  EXPECT_FALSE(parse_robot(doc.dump(), "test.json").zero_axial_spin);
+  doc["strut"]["axial_spin"] = "locked";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.axial_spin: must be \"free\" or \"zeroed\" (got \"locked\")"));
+  doc["strut"]["axial_spin"] = "free";
+  doc["engine"] = "physx";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: engine: must be \"ode\" or \"bullet\""));
+  doc["engine"] = 2;
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: engine: must be a string"));
+}
+
 TEST(Robot, MissingFileIsAClearError) {
   try {
     load_robot("/nonexistent/robot.json");
