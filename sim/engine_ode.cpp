@@ -70,7 +70,11 @@ class OdeEngine final : public Engine {
     dJointGroupDestroy(contacts_);
     dWorldSetStepThreadingImplementation(world_, nullptr, nullptr);
     dWorldDestroy(world_);
-    dThreadingFreeImplementation(threading_);
+    // A step that ODE aborted (ode_fault threw out of it) leaves jobs queued in the
+    // stepping object, and freeing it then trips ODE's own check, which would throw
+    // out of this destructor and terminate (found by fuzz_robot_file). Such a world
+    // is dead; its stepping object is left allocated instead.
+    if (!aborted_) dThreadingFreeImplementation(threading_);
   }
   OdeEngine(const OdeEngine&) = delete;
   OdeEngine& operator=(const OdeEngine&) = delete;
@@ -115,7 +119,12 @@ class OdeEngine final : public Engine {
     ContactReport report;
     if (in.ground) add_ground_contacts(in, report);
     add_strut_contacts(in, report);
-    dWorldStep(world_, dt_s);
+    try {
+      dWorldStep(world_, dt_s);
+    } catch (...) {
+      aborted_ = true;
+      throw;
+    }
     dJointGroupEmpty(contacts_);
     return report;
   }
@@ -184,6 +193,7 @@ class OdeEngine final : public Engine {
   dThreadingImplementationID threading_ = nullptr;
   std::vector<dBodyID> bodies_;
   std::vector<Eigen::Vector3d> inertia_;
+  bool aborted_ = false;
   double soft_erp_ = 0.0;
   double soft_cfm_ = 0.0;
 };

@@ -24,6 +24,8 @@ constexpr double kMaxCoordinateM = 100.0;
 constexpr double kMaxStrutLengthM = 20.0;
 constexpr double kMaxStrutMassKg = 1000.0;
 constexpr double kMaxStrutRadiusM = 1.0;
+// SUPERball's stand-ins are 0.005-0.5 N m s; 1e307 made ODE abort mid-step (fuzzing).
+constexpr double kMaxAxialDampingNms = 100.0;
 
 int node_index(const Reader& r, const json& v, const std::string& path, int node_count) {
   if (!v.is_number_integer()) r.fail_at(path, "must be a node index (integer)");
@@ -66,6 +68,7 @@ void parse_strut(const Reader& r, Robot& robot) {
   if (robot.strut_mass_kg > kMaxStrutMassKg) strut.fail("mass_kg", "must be at most 1000 kg");
   if (robot.strut_radius_m > kMaxStrutRadiusM) strut.fail("radius_m", "must be at most 1 m");
   robot.axial_damping_n_m_s = strut.non_negative("axial_damping_n_m_s", 0.0);
+  if (robot.axial_damping_n_m_s > kMaxAxialDampingNms) strut.fail("axial_damping_n_m_s", "must be at most 100 N m s");
   robot.cable_attachment =
       strut.choice("cable_attachment", {"axis", "surface"}, 0) == 0 ? CableAttachment::axis : CableAttachment::surface;
   robot.zero_axial_spin = strut.choice("axial_spin", {"free", "zeroed"}, 0) == 1;

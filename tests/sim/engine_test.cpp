@@ -9,6 +9,9 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 #include "sim/episode.hpp"
 #include "sim/model.hpp"
@@ -147,6 +150,39 @@ TEST(ZeroedAxialSpin, LeavesNoSpinAboutAnyStrutsAxisInEitherEngine) {
       EXPECT_NEAR(model.axial_spin_rad_per_s(s), 0.0, 1e-5) << "strut " << s;
     }
   }
+}
+
+}  // namespace
+}  // namespace tensegrity::sim
+
+namespace tensegrity::sim {
+namespace {
+
+// fuzz_robot_file found it: an absurd spin damping made ODE abort inside a step,
+// and the aborted world then terminated the process when it was destroyed. The
+// parser now refuses the value; the engine must survive such a step regardless.
+TEST(OdeEngine, AWorldWhoseStepAbortedIsDestroyedCleanly) {
+  std::ifstream in(std::string(TENSEGRITY_SOURCE_DIR) + "/fuzz/regressions/robot_file/axial-damping-1e307.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string json = text.str();
+  const std::string absurd = "0.1e308";
+  ASSERT_NE(json.find(absurd), std::string::npos);
+  json.replace(json.find(absurd), absurd.size(), "0.005");
+  Robot robot = parse_robot(json, "crash.json");
+  robot.axial_damping_n_m_s = 0.1e308;  // past the parser's bound on purpose
+  bool threw = false;
+  {
+    Model model(robot, robot.time_step_s);
+    model.place(robot.nodes_m);
+    const std::vector<double> hold(static_cast<std::size_t>(robot.cable_count()), robot.initial_rest_length_m);
+    try {
+      for (int i = 0; i < 20 && !model.diverged(); ++i) model.step(hold);
+    } catch (const ModelDiverged&) {
+      threw = true;
+    }
+  }  // destroyed here: this used to terminate the process
+  EXPECT_TRUE(threw) << "the input no longer makes ODE abort a step: the test tests nothing";
 }
 
 }  // namespace

@@ -210,6 +210,9 @@ TEST(Robot, EngineAndAxialSpinAreOptionalAndValidated) {
   doc["strut"]["axial_spin"] = "locked";
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.axial_spin: must be \"free\" or \"zeroed\" (got \"locked\")"));
   doc["strut"]["axial_spin"] = "free";
+  doc["strut"]["axial_damping_n_m_s"] = 1e307;
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.axial_damping_n_m_s: must be at most 100 N m s"));
+  doc["strut"]["axial_damping_n_m_s"] = 0.005;
   doc["engine"] = "physx";
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: engine: must be \"ode\" or \"bullet\""));
   doc["engine"] = 2;
