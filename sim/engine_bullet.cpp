@@ -84,8 +84,8 @@ class BulletEngine final : public Engine {
   void set_body(int strut, const BodyState& s) override {
     btRigidBody& b = *bodies_[strut];
     const auto& q = s.quaternion_wxyz;
-    const btQuaternion rotation(static_cast<btScalar>(q[1]), static_cast<btScalar>(q[2]),
-                                static_cast<btScalar>(q[3]), static_cast<btScalar>(q[0]));
+    const btQuaternion rotation(static_cast<btScalar>(q[1]), static_cast<btScalar>(q[2]), static_cast<btScalar>(q[3]),
+                                static_cast<btScalar>(q[0]));
     b.setCenterOfMassTransform(btTransform(rotation, bt(s.position_m)));
     b.setLinearVelocity(bt(s.velocity_m_per_s));
     b.setAngularVelocity(bt(s.angular_velocity_rad_per_s));
