@@ -192,6 +192,8 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   }
   robot.name = r.string("name");
   robot.gravity_m_per_s2 = r.non_negative("gravity_m_per_s2");
+  // Ten times Jupiter's; 1e308 made ODE abort a step (fuzzing).
+  if (robot.gravity_m_per_s2 > 250.0) r.fail("gravity_m_per_s2", "must be at most 250 m/s^2");
   robot.time_step_s = r.positive("time_step_s", 0.0, true);
   robot.engine =
       r.choice("engine", {"ode", "bullet"}, 0) == 0 ? Robot::PhysicsEngine::ode : Robot::PhysicsEngine::bullet;

@@ -213,6 +213,9 @@ TEST(Robot, EngineAndAxialSpinAreOptionalAndValidated) {
   doc["strut"]["axial_damping_n_m_s"] = 1e307;
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: strut.axial_damping_n_m_s: must be at most 100 N m s"));
   doc["strut"]["axial_damping_n_m_s"] = 0.005;
+  doc["gravity_m_per_s2"] = 1e308;
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: gravity_m_per_s2: must be at most 250 m/s^2"));
+  doc["gravity_m_per_s2"] = 9.81;
   doc["engine"] = "physx";
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: engine: must be \"ode\" or \"bullet\""));
   doc["engine"] = 2;
