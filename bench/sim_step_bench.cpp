@@ -12,8 +12,8 @@ namespace {
 
 using namespace tensegrity::sim;
 
-void BM_ModelStep(benchmark::State& state) {
-  const Robot robot = load_robot(default_robot_path());
+// Steps `robot` from its settled start, rest lengths held.
+void step_settled(benchmark::State& state, const Robot& robot) {
   Model model(robot, 0.001);
   model.restore(settled_state(robot, 0.001));
   std::vector<double> preferred(robot.cables.size(), robot.initial_rest_length_m);
@@ -23,6 +23,8 @@ void BM_ModelStep(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
+
+void BM_ModelStep(benchmark::State& state) { step_settled(state, load_robot(default_robot_path())); }
 BENCHMARK(BM_ModelStep);
 
 // What the strut-gap measurement adds to every step, rod contact or not
@@ -78,14 +80,7 @@ void BM_ModelStepBullet(benchmark::State& state) {
   Robot robot = load_robot(default_robot_path());
   robot.engine = Robot::PhysicsEngine::bullet;
   robot.hash += "-bullet";  // settled_state caches by hash
-  Model model(robot, 0.001);
-  model.restore(settled_state(robot, 0.001));
-  std::vector<double> preferred(robot.cables.size(), robot.initial_rest_length_m);
-  for (auto _ : state) {
-    model.step(preferred);
-    benchmark::ClobberMemory();
-  }
-  state.SetItemsProcessed(state.iterations());
+  step_settled(state, robot);
 }
 BENCHMARK(BM_ModelStepBullet);
 
