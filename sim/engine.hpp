@@ -6,6 +6,7 @@
 // Two engines answer issue 14's question whether ODE's contacts are why this model
 // learns slower than the Bullet cross-check: ODE (the default) and Bullet.
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -75,5 +76,9 @@ Eigen::Vector3d capsule_inertia_diag(double mass_kg, double radius_m, double len
 std::unique_ptr<Engine> make_engine(const Robot& robot, double dt_s);
 std::unique_ptr<Engine> make_ode_engine(const Robot& robot, double dt_s);
 std::unique_ptr<Engine> make_bullet_engine(const Robot& robot, double dt_s);
+
+// How many stepping objects of ODE worlds whose step aborted (ModelDiverged thrown
+// from inside dWorldStep) this process holds: ODE cannot free them (engine_ode.cpp).
+std::size_t ode_steppers_held_after_abort();
 
 }  // namespace tensegrity::sim

@@ -39,6 +39,26 @@ void init_ode_for_this_thread() {
 
 Eigen::Vector3d vec(const dReal* v) { return {v[0], v[1], v[2]}; }
 
+// A step that ODE aborted (ode_fault threw out of it) leaves jobs queued in its
+// world's stepping object, and freeing that object then trips ODE's own check, which
+// would throw out of a destructor and terminate (found by fuzz_robot_file). ODE's
+// shutdown and cleanup calls do not empty the queue, so such an object is held here
+// for the life of the process: counted and reachable, not lost (LeakSanitizer, which
+// the fuzzers run, reports lost memory only).
+struct HeldSteppers {
+  std::mutex mutex;
+  std::vector<dThreadingImplementationID> held;
+};
+HeldSteppers& held_steppers() {
+  static auto* steppers = new HeldSteppers;  // never destroyed: outlives every world
+  return *steppers;
+}
+void hold_stepper(dThreadingImplementationID stepper) {
+  HeldSteppers& s = held_steppers();
+  const std::lock_guard lock(s.mutex);
+  s.held.push_back(stepper);
+}
+
 class OdeEngine final : public Engine {
  public:
   OdeEngine(const Robot& robot, double dt_s) : robot_(robot) {
@@ -70,11 +90,11 @@ class OdeEngine final : public Engine {
     dJointGroupDestroy(contacts_);
     dWorldSetStepThreadingImplementation(world_, nullptr, nullptr);
     dWorldDestroy(world_);
-    // A step that ODE aborted (ode_fault threw out of it) leaves jobs queued in the
-    // stepping object, and freeing it then trips ODE's own check, which would throw
-    // out of this destructor and terminate (found by fuzz_robot_file). Such a world
-    // is dead; its stepping object is left allocated instead.
-    if (!aborted_) dThreadingFreeImplementation(threading_);
+    if (aborted_) {
+      hold_stepper(threading_);
+    } else {
+      dThreadingFreeImplementation(threading_);
+    }
   }
   OdeEngine(const OdeEngine&) = delete;
   OdeEngine& operator=(const OdeEngine&) = delete;
@@ -199,6 +219,12 @@ class OdeEngine final : public Engine {
 };
 
 }  // namespace
+
+std::size_t ode_steppers_held_after_abort() {
+  HeldSteppers& s = held_steppers();
+  const std::lock_guard lock(s.mutex);
+  return s.held.size();
+}
 
 Eigen::Vector3d capsule_inertia_diag(double mass_kg, double radius_m, double length_m) {
   dMass mass;
