@@ -30,6 +30,8 @@ void add_stop_command(CLI::App& app);
 void add_estop_command(CLI::App& app);
 void add_clear_fault_command(CLI::App& app);
 void add_status_command(CLI::App& app);
+// `console`: the long-lived operator station (estop key, relays the tools' commands).
+void add_console_command(CLI::App& app);
 void add_record_command(CLI::App& app);
 // `security init|check`: DDS Security keystores (ground/keystore.hpp).
 void add_security_command(CLI::App& app);

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_estop_command(app);
   tensegrity::cli::add_clear_fault_command(app);
   tensegrity::cli::add_status_command(app);
+  tensegrity::cli::add_console_command(app);
   tensegrity::cli::add_record_command(app);
   tensegrity::cli::add_security_command(app);
 #endif

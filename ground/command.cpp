@@ -72,14 +72,22 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
   const auto retry_ns = static_cast<std::int64_t>(options.retry_interval_s * 1e9);
   std::size_t outstanding = report.results.size();
   std::int64_t next_send = start;
+  // A command that may be preempted waits in short slices so that it yields quickly.
+  constexpr std::int64_t kPreemptCheckNs = 20'000'000;
   while (outstanding > 0 && Station::now_ns() < deadline) {
+    if (options.keep_going && !options.keep_going()) {
+      report.preempted = true;
+      break;
+    }
     if (Station::now_ns() >= next_send) {
       // The same (issued time, sequence) again: an end cap that already handled it
       // only repeats its ack.
       station.write_command(cmd);
       next_send = Station::now_ns() + retry_ns;
     }
-    station.wait_for_acks(std::min(next_send, deadline));
+    std::int64_t wake = std::min(next_send, deadline);
+    if (options.keep_going) wake = std::min(wake, Station::now_ns() + kPreemptCheckNs);
+    station.wait_for_acks(wake);
     const std::int64_t arrived = Station::now_ns();
     for (const auto& ack : station.take_command_acks()) {
       if (ack.seq() != cmd.seq()) continue;
@@ -115,7 +123,8 @@ CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandK
     slice.timeout_s = std::min(rejoin.stall_s, static_cast<double>(deadline - slice_start) / 1e9);
     if (!(slice.timeout_s > 0.0)) return report;
     bool progress = false;
-    for (const EndcapCommandResult& got : send_command(*station, kind, start_host_time_ns, slice).results) {
+    const CommandReport got_slice = send_command(*station, kind, start_host_time_ns, slice);
+    for (const EndcapCommandResult& got : got_slice.results) {
       if (!got.acked) continue;
       for (EndcapCommandResult& r : report.results) {
         if (r.endcap != got.endcap) continue;
@@ -125,7 +134,8 @@ CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandK
       missing = static_cast<std::uint16_t>(missing & ~(1U << got.endcap));
       progress = true;
     }
-    if (missing == 0 || Station::now_ns() >= deadline) return report;
+    report.preempted = got_slice.preempted;
+    if (missing == 0 || report.preempted || Station::now_ns() >= deadline) return report;
     if (!progress) {
       station.reset();  // the stalled participant goes first, with its sockets
       station = rejoin.make_station();
@@ -143,6 +153,7 @@ std::string format_command_report(const CommandReport& report) {
                   r.text.c_str());
     out += line;
   }
+  if (report.preempted) out += "ended early: an emergency stop took over, or the console stopped\n";
   if (report.rejoins > 0) {
     out += "rejoined the DDS domain " + std::to_string(report.rejoins) + " time(s) (stalled security handshakes)\n";
   }

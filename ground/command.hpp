@@ -21,6 +21,9 @@ struct CommandOptions {
   std::uint16_t endcap_mask = kAllEndcaps;
   double timeout_s = 5.0;         // the deadline: end caps silent until then are reported missing
   double retry_interval_s = 0.5;  // re-sent (same seq) to every end cap that has not acked
+  // When set, asked every few milliseconds: false ends the command early (an
+  // operator station's emergency stop preempts a stop or clear-fault in flight).
+  std::function<bool()> keep_going;
 };
 // An emergency stop is re-sent more often: each retry is one more chance through a
 // lossy link, and an end cap answers a repeat without acting twice.
@@ -39,7 +42,8 @@ struct CommandReport {
   CommandKind kind = CommandKind::stop;
   std::int64_t start_host_time_ns = 0;
   std::vector<EndcapCommandResult> results;
-  int rejoins = 0;  // send_command_rejoining: fresh participants it took
+  int rejoins = 0;         // send_command_rejoining: fresh participants it took
+  bool preempted = false;  // ended early by options.keep_going
   bool all_accepted() const;
   std::vector<int> missing() const;  // addressed end caps that never acknowledged
 };

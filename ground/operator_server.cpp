@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ground/operator_server.hpp"
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "ground/unix_socket.hpp"
+
+namespace tensegrity::ground {
+namespace {
+
+constexpr std::size_t kMaxRequestBytes = 4096;
+// A client sends its one line at once; one that does not is not kept.
+constexpr std::chrono::milliseconds kRequestTimeout{2000};
+
+// The socket's folder: made 0700, or, if it exists, refused unless only its owner
+// (this user) may enter it; a socket's own mode is not enough on every system.
+void private_folder(const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  struct stat st {};
+  if (::stat(folder.c_str(), &st) != 0) throw OperatorLinkError(folder.string() + ": cannot stat the socket's folder");
+  if (st.st_uid != ::geteuid()) {
+    throw OperatorLinkError(folder.string() + ": the socket's folder belongs to another user");
+  }
+  if ((st.st_mode & 077) != 0 && ::chmod(folder.c_str(), 0700) != 0) {
+    throw OperatorLinkError(folder.string() + ": cannot make the socket's folder private (chmod 700)");
+  }
+}
+
+}  // namespace
+
+OperatorServer::OperatorServer(StationSource station, std::filesystem::path socket_path)
+    : station_(std::move(station)), socket_path_(std::move(socket_path)) {
+  if (!station_) throw std::invalid_argument("operator server: no station");
+  private_folder(socket_path_.parent_path());
+  try {
+    listen_fd_ = listen_unix(socket_path_, 16).release();
+  } catch (const std::runtime_error& e) {
+    throw OperatorLinkError(e.what());
+  }
+  acceptor_ = std::jthread([this](const std::stop_token& stop) { accept_loop(stop); });
+}
+
+OperatorServer::~OperatorServer() {
+  stopping_ = true;
+  acceptor_.request_stop();
+  acceptor_.join();
+  {
+    std::lock_guard lock(connections_mutex_);
+    connections_.clear();  // joins each: their commands end early (stopping_)
+  }
+  ::close(listen_fd_);
+  ::unlink(socket_path_.c_str());
+}
+
+CommandReport OperatorServer::run(const OperatorRequest& request) {
+  const bool estop = request.kind == CommandKind::emergency_stop;
+  if (estop) ++estops_waiting_;
+  std::unique_lock lock(command_mutex_);
+  if (estop) --estops_waiting_;
+  CommandOptions options;
+  options.endcap_mask = request.endcap_mask;
+  options.timeout_s = request.timeout_s;
+  if (estop) {
+    options.retry_interval_s = kEstopRetryIntervalS;
+    options.keep_going = [this] { return !stopping_.load(); };
+  } else {
+    options.keep_going = [this] { return estops_waiting_.load() == 0 && !stopping_.load(); };
+  }
+  const std::shared_ptr<Station> station = station_();
+  return send_command(*station, request.kind, 0, options);
+}
+
+void OperatorServer::accept_loop(const std::stop_token& stop) {
+  while (!stop.stop_requested()) {
+    pollfd p{listen_fd_, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    UniqueFd fd(::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC));
+    if (!fd) continue;
+    reap_finished();
+    const long uid = peer_uid(fd.get());
+    std::lock_guard lock(connections_mutex_);
+    if (uid != static_cast<long>(::geteuid()) || connections_.size() >= kMaxConnections) {
+      OperatorReply reply;
+      reply.console_pid = ::getpid();
+      reply.error = uid != static_cast<long>(::geteuid()) ? "the console serves its own user only"
+                                                          : "the console is busy (8 connections open)";
+      ++refused_;
+      try {
+        write_all(fd.get(), encode_reply(reply) + "\n");
+      } catch (const std::runtime_error&) {  // the peer went away: nothing to tell
+      }
+      continue;
+    }
+    Connection& c = connections_.emplace_back();
+    c.thread = std::jthread([this, &c, raw = fd.release()] {
+      serve(raw);
+      c.done = true;
+    });
+  }
+}
+
+void OperatorServer::reap_finished() {
+  std::lock_guard lock(connections_mutex_);
+  connections_.remove_if([](const Connection& c) { return c.done.load(); });
+}
+
+void OperatorServer::serve(int raw_fd) {
+  const UniqueFd fd(raw_fd);
+  OperatorReply reply;
+  reply.console_pid = ::getpid();
+  try {
+    const OperatorRequest request = decode_request(read_line(fd.get(), kMaxRequestBytes, kRequestTimeout));
+    reply.report = run(request);
+    ++served_;
+    const CommandReport& r = reply.report;
+    double last_s = 0.0;
+    for (const auto& result : r.results) last_s = std::max(last_s, result.latency_s);
+    std::fprintf(stderr, "console: relayed %s: %zu of %zu acked, last ack %.1f ms%s\n", to_string(r.kind),
+                 r.results.size() - r.missing().size(), r.results.size(), last_s * 1e3,
+                 r.preempted ? " (ended early)" : "");
+  } catch (const PeerClosed&) {
+    return;  // a connection without a request: another console checking that this one lives
+  } catch (const std::exception& e) {
+    reply.error = e.what();
+    ++refused_;
+  }
+  try {
+    write_all(fd.get(), encode_reply(reply) + "\n");
+  } catch (const std::runtime_error& e) {
+    std::fprintf(stderr, "console: a client left before its reply: %s\n", e.what());
+  }
+}
+
+}  // namespace tensegrity::ground

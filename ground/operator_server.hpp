@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: Apache-2.0
+// The console's side of its local socket (ground/operator_protocol.hpp): relays
+// estop, stop and clear-fault from ground tools on this machine to the end caps
+// through the console's long-lived, already authenticated station.
+//
+// Who may use it: the socket sits in a folder only its user may enter (0700), and
+// each peer's uid is checked (SO_PEERCRED) against this process's, so a command
+// still comes from someone who holds the ground identity's key, not from anyone on
+// the machine. One thread per connection (at most kMaxConnections); commands run
+// one at a time, and an emergency stop preempts a stop or clear-fault in flight
+// (its acknowledgement wait, not its effect: the preempted command was already sent).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "ground/command.hpp"
+#include "ground/operator_protocol.hpp"
+
+namespace tensegrity::ground {
+
+class OperatorServer {
+ public:
+  static constexpr int kMaxConnections = 8;
+  using StationSource = std::function<std::shared_ptr<Station>()>;
+
+  // Listens on `socket_path`, making its folder (0700). A socket left by a console
+  // that died is replaced; one a live console answers on is refused (OperatorLinkError).
+  OperatorServer(StationSource station, std::filesystem::path socket_path);
+  ~OperatorServer();  // stops serving and removes the socket
+  OperatorServer(const OperatorServer&) = delete;
+  OperatorServer& operator=(const OperatorServer&) = delete;
+
+  // Runs one command on the current station: what a connection asks for, and what
+  // the console's own keys do.
+  CommandReport run(const OperatorRequest& request);
+
+  // Commands in flight end at their next check (a few ms); new ones return at once.
+  void shutdown() { stopping_ = true; }
+
+  const std::filesystem::path& socket_path() const { return socket_path_; }
+  std::uint64_t served() const { return served_.load(); }
+  std::uint64_t refused() const { return refused_.load(); }
+
+ private:
+  void accept_loop(const std::stop_token& stop);
+  void serve(int raw_fd);
+  void reap_finished();
+
+  StationSource station_;
+  std::filesystem::path socket_path_;
+  int listen_fd_ = -1;
+  std::mutex command_mutex_;                   // one command at a time
+  std::atomic<int> estops_waiting_{0};         // > 0: a command in flight yields
+  std::atomic<bool> stopping_{false};
+  std::atomic<std::uint64_t> served_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::mutex connections_mutex_;
+  struct Connection {
+    std::jthread thread;
+    std::atomic<bool> done{false};
+  };
+  std::list<Connection> connections_;
+  std::jthread acceptor_;
+};
+
+}  // namespace tensegrity::ground

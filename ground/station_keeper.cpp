@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "ground/station_keeper.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+#include <utility>
+
+namespace tensegrity::ground {
+
+StationKeeper::StationKeeper(MakeStation make, const Options& options)
+    : make_(std::move(make)), options_(options), stall_s_(options.stall_s) {
+  if (!make_) throw std::invalid_argument("station keeper: no way to make a station");
+  if (!(options.stall_s > 0.0) || !(options.trial_s > 0.0) || !(options.fresh_s > 0.0)) {
+    throw std::invalid_argument("station keeper: stall, trial and freshness times must be > 0 s");
+  }
+  current_ = make_();
+  last_growth_ns_ = Station::now_ns();
+}
+
+std::shared_ptr<Station> StationKeeper::current() const {
+  std::lock_guard lock(mutex_);
+  return current_;
+}
+
+int StationKeeper::rejoins() const {
+  std::lock_guard lock(mutex_);
+  return rejoins_;
+}
+
+std::uint16_t StationKeeper::heard(const Station& station, std::uint16_t expected, std::int64_t now_ns,
+                                   double fresh_s) {
+  const auto fresh_ns = static_cast<std::int64_t>(fresh_s * 1e9);
+  const auto snapshot = station.snapshot();
+  std::uint16_t mask = 0;
+  for (int e = 0; e < kEndcapCount; ++e) {
+    const EndcapStatus& s = snapshot[static_cast<std::size_t>(e)];
+    if ((expected & (1U << e)) != 0 && s.seen && now_ns - s.heartbeat_host_ns <= fresh_ns) {
+      mask = static_cast<std::uint16_t>(mask | (1U << e));
+    }
+  }
+  return mask;
+}
+
+void StationKeeper::tick(std::int64_t now_ns) {
+  std::unique_lock lock(mutex_);
+  const std::uint16_t now_heard = heard(*current_, options_.expected, now_ns, options_.fresh_s);
+  if ((now_heard & ~last_heard_) != 0) last_growth_ns_ = now_ns;
+  last_heard_ = now_heard;
+  if (candidate_) {
+    // A candidate takes over when it hears every end cap, or at the end of its
+    // trial if it hears more than the current station (not before: one still
+    // discovering would win with a partial set).
+    const std::uint16_t got = heard(*candidate_, options_.expected, now_ns, options_.fresh_s);
+    const bool trial_over = now_ns - candidate_since_ns_ > static_cast<std::int64_t>(options_.trial_s * 1e9);
+    if (got == options_.expected || (trial_over && std::popcount(got) > std::popcount(now_heard))) {
+      current_ = std::shared_ptr<Station>(std::move(candidate_));  // the old one ends with its last user
+      ++rejoins_;
+      stall_s_ = options_.stall_s;
+      last_heard_ = got;
+      last_growth_ns_ = now_ns;
+    } else if (trial_over) {
+      candidate_.reset();
+      stall_s_ = std::min(2.0 * stall_s_, options_.max_stall_s);
+      last_growth_ns_ = now_ns;
+    }
+    return;
+  }
+  const bool stalled = now_heard != options_.expected &&
+                       now_ns - last_growth_ns_ > static_cast<std::int64_t>(stall_s_ * 1e9);
+  if (!stalled) return;
+  lock.unlock();  // making a participant takes a while; current() must not wait for it
+  std::unique_ptr<Station> fresh = make_();
+  lock.lock();
+  candidate_ = std::move(fresh);
+  candidate_since_ns_ = Station::now_ns();
+}
+
+}  // namespace tensegrity::ground
