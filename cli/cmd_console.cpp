@@ -61,8 +61,8 @@ class KeyCommands {
   std::vector<std::jthread> workers_;
 };
 
-void show(const ground::Station& station, std::uint16_t expected, bool terminal,
-          const std::string& header, const std::string& last) {
+void show(const ground::Station& station, std::uint16_t expected, bool terminal, const std::string& header,
+          const std::string& last) {
   const std::int64_t now = ground::Station::now_ns();
   if (terminal) std::fputs("\033[H\033[2J", stdout);  // a live table, as `status` draws it
   std::fputs(header.c_str(), stdout);
@@ -101,7 +101,8 @@ void run_console(const ConsoleArgs& args) {
     if (key == ConsoleKey::quit) break;
     if (key == ConsoleKey::estop) commands.send(ground::CommandKind::emergency_stop, expected, args.ground.timeout_s);
     if (key == ConsoleKey::stop) commands.send(ground::CommandKind::stop, expected, args.ground.timeout_s);
-    if (key == ConsoleKey::clear_fault) commands.send(ground::CommandKind::clear_fault, expected, args.ground.timeout_s);
+    if (key == ConsoleKey::clear_fault)
+      commands.send(ground::CommandKind::clear_fault, expected, args.ground.timeout_s);
     const std::int64_t now = ground::Station::now_ns();
     keeper.tick(now);
     const auto [last, reports] = commands.last();

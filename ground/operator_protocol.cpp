@@ -49,12 +49,9 @@ std::uint16_t read_mask(const Reader& r) {
 }
 
 json encode_result(const EndcapCommandResult& r) {
-  return {{"endcap", r.endcap},
-          {"acked", r.acked},
-          {"accepted", r.accepted},
-          {"reason", static_cast<int>(r.reason)},
-          {"text", r.text},
-          {"latency_s", r.latency_s}};
+  return {{"endcap", r.endcap},     {"acked", r.acked},
+          {"accepted", r.accepted}, {"reason", static_cast<int>(r.reason)},
+          {"text", r.text},         {"latency_s", r.latency_s}};
 }
 
 EndcapCommandResult decode_result(const Reader& r) {

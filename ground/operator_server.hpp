@@ -56,8 +56,8 @@ class OperatorServer {
   StationSource station_;
   std::filesystem::path socket_path_;
   int listen_fd_ = -1;
-  std::mutex command_mutex_;                   // one command at a time
-  std::atomic<int> estops_waiting_{0};         // > 0: a command in flight yields
+  std::mutex command_mutex_;            // one command at a time
+  std::atomic<int> estops_waiting_{0};  // > 0: a command in flight yields
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint64_t> served_{0};
   std::atomic<std::uint64_t> refused_{0};

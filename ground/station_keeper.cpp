@@ -66,8 +66,8 @@ void StationKeeper::tick(std::int64_t now_ns) {
     }
     return;
   }
-  const bool stalled = now_heard != options_.expected &&
-                       now_ns - last_growth_ns_ > static_cast<std::int64_t>(stall_s_ * 1e9);
+  const bool stalled =
+      now_heard != options_.expected && now_ns - last_growth_ns_ > static_cast<std::int64_t>(stall_s_ * 1e9);
   if (!stalled) return;
   lock.unlock();  // making a participant takes a while; current() must not wait for it
   std::unique_ptr<Station> fresh = make_();

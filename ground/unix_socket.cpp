@@ -87,7 +87,8 @@ std::string read_line(int fd, std::size_t max_bytes, std::chrono::milliseconds t
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   char c = 0;
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     pollfd p{fd, POLLIN, 0};
     if (left.count() <= 0 || ::poll(&p, 1, static_cast<int>(left.count())) <= 0) {
       throw std::runtime_error("no complete line within " + std::to_string(timeout.count()) + " ms");

@@ -159,8 +159,8 @@ TEST_F(ConsoleLink, AnEstopPreemptsAStopInFlight) {
   EXPECT_EQ(estop->report.results.size(), 3U);
   double worst = 0;
   for (const auto& r : estop->report.results) worst = std::max(worst, r.latency_s);
-  std::printf("MEASURE console estop after preempting a stop: last ack %.1f ms, stop ended after %.2f s\n",
-              worst * 1e3, elapsed_s);
+  std::printf("MEASURE console estop after preempting a stop: last ack %.1f ms, stop ended after %.2f s\n", worst * 1e3,
+              elapsed_s);
 }
 
 // A station that hears nobody (here: made on another domain, as a stalled security
@@ -210,9 +210,9 @@ TEST_F(ConsoleLink, TheEstopToolSendsThroughARunningConsole) {
   Subprocess nodes({COMMS_TEST_NODE, "--domain", domain, "--endcaps", "0-2"}, dir_ / "nodes.out", dir_ / "nodes.err");
   ASSERT_TRUE(nodes.wait_for_output("READY", std::chrono::seconds(20)));
   const std::string socket = (dir_ / "c.sock").string();
-  Subprocess console({TENSEGRITY_CLI, "console", "--insecure", "--domain", domain, "--endcaps", "0-2", "--socket",
-                      socket},
-                     dir_ / "console.out", dir_ / "console.err");
+  Subprocess console(
+      {TENSEGRITY_CLI, "console", "--insecure", "--domain", domain, "--endcaps", "0-2", "--socket", socket},
+      dir_ / "console.out", dir_ / "console.err");
   ASSERT_TRUE(console.wait_for_output("hears 3 of 3", std::chrono::seconds(30)));
 
   Subprocess estop({TENSEGRITY_CLI, "estop", "--insecure", "--domain", domain, "--endcaps", "0-2", "--console", socket},
