@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // `tensegrity security init DIR`: a DDS Security keystore (ground/keystore.hpp) with
 // the project CA, the ground, 12 end-cap and listener enclaves and their signed
-// governance and permissions; `security check DIR` says whether one is complete.
+// governance and permissions; `security check DIR` says whether one is complete;
+// `security revoke NAME DIR` withdraws a lost board's identity.
 #include <cstdio>
 
 #include "cli/commands.hpp"
@@ -9,6 +10,43 @@
 #include "msgs/security.hpp"
 
 namespace tensegrity::cli {
+namespace {
+
+void add_revoke(CLI::App& security) {
+  struct RevokeArgs {
+    std::string name;
+    std::string dir;
+    int days = 3650;
+  };
+  auto args = std::make_shared<RevokeArgs>();
+  CLI::App* cmd = security.add_subcommand(
+      "revoke",
+      "Withdraw an identity (a lost or stolen board): revoke its certificate, put the CA's revocation list "
+      "(crl.pem) in every enclave, and give the enclave a new identity for its replacement");
+  cmd->add_option("name", args->name, "Enclave: ground, listener or endcap_NN (or /tensegrity/...)")->required();
+  cmd->add_option("dir", args->dir, "Keystore folder (default as for init)");
+  cmd->add_option("--days", args->days, "Validity of the new certificate and the list, days")
+      ->check(CLI::Range(1, 36500))
+      ->capture_default_str();
+  cmd->callback([args] {
+    const std::filesystem::path dir = args->dir.empty() ? msgs::default_keystore() : std::filesystem::path(args->dir);
+    const std::string enclave = args->name.starts_with('/') ? args->name : "/tensegrity/" + args->name;
+    ground::Revocation r;
+    try {
+      r = ground::revoke_enclave(dir, enclave, args->days);
+    } catch (const ground::KeystoreError& e) {
+      throw CommandError(1, e.what());
+    }
+    std::printf("revoked %s certificate serial %s (%d on the list); its new serial %s\n", enclave.c_str(),
+                r.revoked_serial.c_str(), r.revoked_total, r.new_serial.c_str());
+    std::printf(
+        "copy crl.pem (%s/public/crl.pem, the same in every enclave) to every board, and the new %s enclave "
+        "to the replacement board: until a participant has the list it still accepts the old identity\n",
+        dir.string().c_str(), enclave.c_str());
+  });
+}
+
+}  // namespace
 
 void add_security_command(CLI::App& app) {
   CLI::App* security = app.add_subcommand("security", "DDS Security keystores (SROS2 layout)");
@@ -50,6 +88,7 @@ void add_security_command(CLI::App& app) {
     if (const std::string problem = ground::keystore_problem(dir); !problem.empty()) throw CommandError(1, problem);
     std::printf("keystore %s: complete (%zu enclaves)\n", dir.string().c_str(), msgs::all_enclaves().size());
   });
+  add_revoke(*security);
 }
 
 }  // namespace tensegrity::cli

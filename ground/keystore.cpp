@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "ground/keystore.hpp"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,42 +12,14 @@
 #include <string>
 #include <vector>
 
+#include "ground/openssl_cli.hpp"
 #include "msgs/security.hpp"
-
-extern char** environ;
 
 namespace tensegrity::ground {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// Runs `openssl ARGS...` (no shell), its output into `log`; throws with the log's
-// text when it fails.
-void openssl(std::vector<std::string> args, const fs::path& log) {
-  args.insert(args.begin(), "openssl");
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, "openssl", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw KeystoreError(std::string("cannot run openssl (Debian package openssl): ") + std::strerror(rc));
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return;
-  std::ifstream in(log);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  std::string cmd;
-  for (std::size_t i = 0; i + 1 < argv.size(); ++i) cmd += std::string(i ? " " : "") + argv[i];
-  throw KeystoreError(cmd + " failed:\n" + text);
-}
 
 void write_text(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -67,13 +36,6 @@ std::string utc(std::time_t t) {
   return text;
 }
 
-// "/tensegrity/ground" -> "/CN=\/tensegrity\/ground" (openssl -subj escapes '/').
-std::string subj(const std::string& enclave) {
-  std::string out = "/CN=";
-  for (char c : enclave) out += (c == '/') ? std::string("\\/") : std::string(1, c);
-  return out;
-}
-
 void sign(const fs::path& in, const fs::path& out, const fs::path& ca_cert, const fs::path& ca_key,
           const fs::path& log) {
   // S/MIME with the document as text, as SROS2 signs them and Fast DDS reads them.
@@ -87,16 +49,7 @@ void make_enclave(const fs::path& root, const std::string& enclave, int serial, 
   const fs::path dir = msgs::enclave_dir(root, enclave);
   const fs::path ca_cert = root / "public" / "ca.cert.pem", ca_key = root / "private" / "ca.key.pem";
   fs::create_directories(dir);
-  const std::string req = (dir / "req.pem").string();
-  openssl({"req", "-new", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes", "-keyout",
-           (dir / "key.pem").string(), "-out", req, "-subj", subj(enclave)},
-          log);
-  openssl({"x509", "-req", "-in", req, "-CA", ca_cert.string(), "-CAkey", ca_key.string(), "-set_serial",
-           std::to_string(serial), "-days", std::to_string(options.valid_days), "-sha256", "-out",
-           (dir / "cert.pem").string()},
-          log);
-  fs::remove(req);
-  fs::permissions(dir / "key.pem", fs::perms::owner_read | fs::perms::owner_write);
+  issue_identity(root, enclave, dir, std::to_string(serial), options.valid_days, log);
   fs::copy_file(ca_cert, dir / "identity_ca.cert.pem");
   fs::copy_file(ca_cert, dir / "permissions_ca.cert.pem");
   fs::copy_file(root / "enclaves" / "governance.p7s", dir / "governance.p7s");

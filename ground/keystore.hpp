@@ -45,4 +45,18 @@ bool keystore_complete(const std::filesystem::path& dir);
 // Returns true when this call created it.
 bool ensure_keystore(const std::filesystem::path& dir);
 
+// Withdraws the identity of `enclave` ("/tensegrity/endcap_05"), as for a lost or
+// stolen board: its certificate goes on the CA's revocation list (a database in
+// KEYSTORE/private/ca.db, the signed list in KEYSTORE/public/crl.pem), the list is
+// copied into every enclave as crl.pem (SROS2's name; Fast DDS's identity_crl), and
+// the enclave gets a new key and certificate for its replacement board. Every
+// participant given the new crl.pem refuses the old certificate; boards must get
+// the file (it is the same in every enclave). Throws KeystoreError.
+struct Revocation {
+  std::string revoked_serial;  // as openssl prints it, hex
+  std::string new_serial;
+  int revoked_total = 0;  // certificates on the list now
+};
+Revocation revoke_enclave(const std::filesystem::path& dir, const std::string& enclave, int valid_days = 3650);
+
 }  // namespace tensegrity::ground

@@ -46,13 +46,21 @@ fs::path default_keystore() {
 }
 
 EnclaveFiles enclave_files(const fs::path& dir) {
-  return EnclaveFiles{dir / "identity_ca.cert.pem",    dir / "cert.pem",       dir / "key.pem",
-                      dir / "permissions_ca.cert.pem", dir / "governance.p7s", dir / "permissions.p7s"};
+  EnclaveFiles files{dir / "identity_ca.cert.pem",
+                     dir / "cert.pem",
+                     dir / "key.pem",
+                     dir / "permissions_ca.cert.pem",
+                     dir / "governance.p7s",
+                     dir / "permissions.p7s",
+                     {}};
+  if (fs::exists(dir / "crl.pem")) files.revocations = dir / "crl.pem";
+  return files;
 }
 
 void check_enclave(const EnclaveFiles& files) {
   for (const fs::path* p : {&files.identity_ca, &files.certificate, &files.private_key, &files.permissions_ca,
-                            &files.governance, &files.permissions}) {
+                            &files.governance, &files.permissions, &files.revocations}) {
+    if (p == &files.revocations && p->empty()) continue;  // optional
     std::ifstream in(*p);
     if (!in) {
       throw DdsError("DDS security: " + p->string() +
@@ -71,6 +79,9 @@ void apply_security(eprosima::fastdds::dds::DomainParticipantQos& qos, const Enc
   props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", file(files.identity_ca));
   props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", file(files.certificate));
   props.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", file(files.private_key));
+  if (!files.revocations.empty()) {
+    props.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_crl", file(files.revocations));
+  }
   props.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", file(files.permissions_ca));
   props.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", file(files.governance));

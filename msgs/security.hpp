@@ -48,6 +48,10 @@ struct EnclaveFiles {
   std::filesystem::path permissions_ca;  // permissions_ca.cert.pem
   std::filesystem::path governance;      // governance.p7s
   std::filesystem::path permissions;     // permissions.p7s
+  // crl.pem, the CA's certificate revocation list (`tensegrity security revoke`):
+  // optional, empty when the enclave has none. With it, a participant refuses peers
+  // whose certificate the list revokes.
+  std::filesystem::path revocations;
 };
 EnclaveFiles enclave_files(const std::filesystem::path& enclave_dir);
 // Throws DdsError naming the first file that is missing or unreadable.

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // `tensegrity security init`'s keystore: SROS2's layout, every enclave complete,
 // documents signed by the CA (checked with openssl, as a second reader), private
-// keys readable by their owner only, never half-written, safe to race for.
+// keys readable by their owner only, never half-written, safe to race for; a
+// revoked identity on the CA's list in every enclave.
 #include "ground/keystore.hpp"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <thread>
 
 #include "msgs/security.hpp"
@@ -58,6 +60,41 @@ TEST_F(Keystore, InitMakesSros2sLayoutWithSignedDocuments) {
       sh("openssl smime -verify -in " + (msgs::enclave_dir(ks, "/tensegrity/ground") / "permissions.p7s").string() +
          " -CAfile " + ca.string() + " | grep -q 'rt/tensegrity/command'"),
       0);
+}
+
+TEST_F(Keystore, RevokingListsTheOldCertificateEverywhereAndIssuesANewOne) {
+  const fs::path ks = dir_ / "ks";
+  create_keystore(ks);
+  const std::string e3 = msgs::enclave_name(msgs::Role::endcap, 3), e7 = msgs::enclave_name(msgs::Role::endcap, 7);
+  const fs::path old3 = dir_ / "old3.pem", old7 = dir_ / "old7.pem";
+  fs::copy_file(msgs::enclave_dir(ks, e3) / "cert.pem", old3);
+  fs::copy_file(msgs::enclave_dir(ks, e7) / "cert.pem", old7);
+  const Revocation first = revoke_enclave(ks, e3);
+  const Revocation second = revoke_enclave(ks, e7);
+  EXPECT_EQ(first.revoked_total, 1);
+  EXPECT_EQ(second.revoked_total, 2) << "a revocation must add to the list, not replace it";
+  EXPECT_NE(first.new_serial, first.revoked_serial);
+  const std::string ca = (ks / "public" / "ca.cert.pem").string();
+  const std::string crl = (ks / "public" / "crl.pem").string();
+  const std::string check = "openssl verify -crl_check -CAfile " + ca + " -CRLfile " + crl + " ";
+  EXPECT_NE(sh(check + old3.string()), 0) << "the lost board's certificate still verifies";
+  EXPECT_NE(sh(check + old7.string()), 0);
+  EXPECT_EQ(sh(check + (msgs::enclave_dir(ks, e3) / "cert.pem").string()), 0) << "the new certificate";
+  EXPECT_EQ(sh(check + (msgs::enclave_dir(ks, msgs::enclave_name(msgs::Role::ground)) / "cert.pem").string()), 0);
+  // The new key is the new certificate's, and private.
+  const std::string e3dir = msgs::enclave_dir(ks, e3).string();
+  EXPECT_EQ(sh("test \"$(openssl x509 -in " + e3dir + "/cert.pem -noout -pubkey)\" = \"$(openssl pkey -in " + e3dir +
+               "/key.pem -pubout)\""),
+            0);
+  EXPECT_EQ(fs::status(msgs::enclave_dir(ks, e3) / "key.pem").permissions() & fs::perms::others_all, fs::perms::none);
+  std::ifstream list_in(crl);
+  const std::string list((std::istreambuf_iterator<char>(list_in)), {});
+  for (const std::string& enclave : msgs::all_enclaves()) {
+    std::ifstream in(msgs::enclave_dir(ks, enclave) / "crl.pem");
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), {}), list) << enclave << ": not the current list";
+  }
+  EXPECT_TRUE(keystore_complete(ks));
+  EXPECT_THROW(revoke_enclave(ks, "/tensegrity/endcap_12"), KeystoreError);
 }
 
 TEST_F(Keystore, AnExistingKeystoreIsKeptUnlessReplaced) {

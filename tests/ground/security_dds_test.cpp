@@ -4,7 +4,8 @@
 // other identities. Only the keystore's ground identity is heard and obeyed; an
 // unauthenticated participant, one of another CA, and one holding an end cap's
 // identity may not upload, start, clear a fault or answer a time sync; an end cap's
-// identity may not speak for another end cap. Domains 175-179.
+// identity may not speak for another end cap; a revoked identity is refused.
+// Domains 175-179, 185.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -216,6 +217,43 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
   EXPECT_GE(ground->impostor_samples(), 2U) << "the impostor's samples never reached the ground";
   for (const auto& a : ground->take_command_acks()) EXPECT_NE(a.seq(), 424242U) << "a forged ack was taken";
   EXPECT_NE(ground->snapshot()[2].heartbeat.seq(), hb.seq()) << "end cap 2's status shows the impostor's heartbeat";
+}
+
+// A lost board keeps a certificate the CA signed; `security revoke` puts it on the
+// revocation list that every other participant is given (crl.pem in its enclave).
+TEST_F(SecureDds, ARevokedIdentityIsRefusedByEveryoneGivenTheList) {
+  constexpr int kDomain = 185;
+  fs::copy(root_ / "keystore", root_ / "revoked", fs::copy_options::recursive);
+  fs::copy(root_ / "keystore", root_ / "lost", fs::copy_options::recursive);  // the board, as it was lost
+  const Revocation r = revoke_enclave(root_ / "revoked", msgs::enclave_name(msgs::Role::endcap, 1));
+  EXPECT_EQ(r.revoked_total, 1);
+  auto node = [&](const std::string& endcaps, const std::string& store) {
+    return std::make_unique<Subprocess>(
+        std::vector<std::string>{COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", endcaps,
+                                 "--keystore", (root_ / store).string()},
+        root_ / ("nodes_" + store + ".out"), root_ / ("nodes_" + store + ".err"));
+  };
+  const auto others = node("0,2", "revoked");  // end caps 0 and 2 have the list
+  const auto thief = node("1", "lost");        // end cap 1's old identity, no list
+  ASSERT_TRUE(others->wait_for_output("READY", std::chrono::seconds(30)));
+  ASSERT_TRUE(thief->wait_for_output("READY", std::chrono::seconds(30)));
+  auto ground = station(kDomain, enclave("revoked", msgs::Role::ground));
+  ASSERT_TRUE(ground->wait_for_endcaps(0b101, false, after_s(30))) << "the boards in good standing";
+  EXPECT_FALSE(ground->wait_for_endcaps(0b010, false, after_s(8))) << "the revoked identity was heard";
+  // The control: a ground without the list hears the old identity, so the list is
+  // what refused it (not a broken node).
+  auto unaware = station(kDomain, enclave("lost", msgs::Role::ground), /*serve_time=*/false);
+  EXPECT_TRUE(unaware->wait_for_endcaps(0b010, false, after_s(30))) << "the old identity never worked at all";
+  // The replacement board's new identity is heard.
+  const auto replacement = node("1", "revoked");
+  ASSERT_TRUE(replacement->wait_for_output("READY", std::chrono::seconds(30)));
+  const auto t0 = std::chrono::steady_clock::now();
+  bool heard_new = false;
+  while (!heard_new && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(30)) {
+    // Heard through the listed ground only if the new certificate authenticates.
+    heard_new = ground->wait_for_endcaps(0b010, false, after_s(0.5));
+  }
+  EXPECT_TRUE(heard_new) << "the replacement identity was not heard";
 }
 
 TEST_F(SecureDds, AMissingEnclaveFileIsNamed) {
