@@ -53,7 +53,12 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
   try {
     reply = ground::ask_console(socket, request);
   } catch (const ground::OperatorLinkError& e) {
-    throw CommandError(1, name + ": " + e.what());
+    // A console named with --console must answer; a broken default one must not
+    // keep a stop from going out: the tool then speaks itself.
+    if (!args.console.empty()) throw CommandError(1, name + ": " + e.what());
+    std::fprintf(stderr, "%s: the console at %s did not answer properly (%s); sending on this tool's own participant\n",
+                 name.c_str(), socket.c_str(), e.what());
+    return false;
   }
   if (!reply) {
     if (!args.console.empty()) throw CommandError(1, name + ": no console listens at " + socket.string());

@@ -11,7 +11,12 @@
 namespace tensegrity::ground {
 
 std::optional<OperatorReply> ask_console(const std::filesystem::path& socket_path, const OperatorRequest& request) {
-  UniqueFd fd = connect_unix(socket_path);
+  UniqueFd fd;
+  try {
+    fd = connect_unix(socket_path);
+  } catch (const std::runtime_error& e) {  // a path no socket can have
+    throw OperatorLinkError(e.what());
+  }
   if (!fd) {
     if (errno == ENOENT || errno == ECONNREFUSED) return std::nullopt;
     throw OperatorLinkError(socket_path.string() + ": cannot reach the console: " + std::strerror(errno));
