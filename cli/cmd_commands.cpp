@@ -7,6 +7,7 @@
 // When an operator console (`tensegrity console`) runs for the domain, the command
 // goes through it instead: its station is already authenticated with the end caps,
 // so a secured estop lands in milliseconds rather than after seconds of handshakes.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -48,7 +49,7 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
   ground::OperatorRequest request;
   request.kind = kind;
   request.endcap_mask = parse_endcap_set(args.ground.endcaps);
-  request.timeout_s = args.ground.timeout_s;
+  request.timeout_s = std::min(args.ground.timeout_s, ground::kMaxOperatorTimeoutS);
   std::optional<ground::OperatorReply> reply;
   try {
     reply = ground::ask_console(socket, request);
@@ -64,7 +65,20 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
     if (!args.console.empty()) throw CommandError(1, name + ": no console listens at " + socket.string());
     return false;
   }
-  if (!reply->error.empty()) throw CommandError(1, name + ": the console refused: " + reply->error);
+  const bool none_acked = reply->report.missing().size() == reply->report.results.size();
+  if (!reply->error.empty() || (reply->report.preempted && none_acked)) {
+    // Refused (busy, stopping) or ended before any end cap answered: the command may
+    // not have gone out, so on the default socket the tool sends it itself.
+    const std::string why = reply->error.empty() ? "it stopped before any end cap answered" : reply->error;
+    if (!args.console.empty()) throw CommandError(1, name + ": the console did not send it: " + why);
+    std::fprintf(stderr, "%s: the console at %s did not send it (%s); sending on this tool's own participant\n",
+                 name.c_str(), socket.c_str(), why.c_str());
+    return false;
+  }
+  if (reply->report.preempted) {
+    std::fprintf(stderr, "%s: an emergency stop sent after it took over%s\n", name.c_str(),
+                 kind == ground::CommandKind::emergency_stop ? " and goes on to the end caps still missing here" : "");
+  }
   std::fprintf(stderr, "%s: sent by the console at %s (pid %ld) with its station's identity\n", name.c_str(),
                socket.c_str(), reply->console_pid);
   check_report(name, reply->report);

@@ -7,6 +7,7 @@
 // with a console running, `tensegrity estop` lands in milliseconds instead of after
 // a fresh participant's seconds of security handshakes.
 #include <bit>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -33,20 +34,31 @@ struct ConsoleArgs {
   double period_s = 0.5;
 };
 
-// Commands from keys run beside the display, one at a time; the last report stays
-// on screen.
+// Commands from keys run beside the display, one at a time in the server; the
+// last report stays on screen. A key estop while one is already on its way is not
+// queued again (holding the key must not stack up stops).
 class KeyCommands {
  public:
   explicit KeyCommands(ground::OperatorServer& server) : server_(server) {}
   void send(ground::CommandKind kind, std::uint16_t mask, double timeout_s) {
-    // An estop goes at once (the server preempts whatever runs); others wait.
-    workers_.emplace_back([this, kind, mask, timeout_s] {
-      ground::OperatorRequest request{kind, mask, timeout_s};
-      const ground::CommandReport report = server_.run(request);
-      std::lock_guard lock(mutex_);
-      last_ = std::string("last command: ") + ground::to_string(kind) + "\n" + ground::format_command_report(report);
-      ++reports_;
-    });
+    const bool estop = kind == ground::CommandKind::emergency_stop;
+    if (estop && estop_pending_.exchange(true)) return;
+    std::erase_if(workers_, [](const Worker& w) { return w.done->load(); });
+    auto done = std::make_shared<std::atomic<bool>>(false);
+    workers_.push_back({std::jthread([this, kind, mask, timeout_s, estop, done] {
+                          std::string text;
+                          try {
+                            text = ground::format_command_report(server_.run({kind, mask, timeout_s}));
+                          } catch (const std::exception& e) {
+                            text = std::string("not sent: ") + e.what() + "\n";
+                          }
+                          if (estop) estop_pending_ = false;
+                          std::lock_guard lock(mutex_);
+                          last_ = std::string("last command: ") + ground::to_string(kind) + "\n" + text;
+                          ++reports_;
+                          *done = true;
+                        }),
+                        done});
   }
   std::pair<std::string, int> last() const {
     std::lock_guard lock(mutex_);
@@ -54,11 +66,16 @@ class KeyCommands {
   }
 
  private:
+  struct Worker {
+    std::jthread thread;
+    std::shared_ptr<std::atomic<bool>> done;
+  };
   ground::OperatorServer& server_;
+  std::atomic<bool> estop_pending_{false};
   mutable std::mutex mutex_;
   std::string last_;
   int reports_ = 0;
-  std::vector<std::jthread> workers_;
+  std::vector<Worker> workers_;  // touched by the key loop only
 };
 
 void show(const ground::Station& station, std::uint16_t expected, bool terminal, const std::string& header,
@@ -93,6 +110,13 @@ void run_console(const ConsoleArgs& args) {
   StopOnSignals signals;
   ConsoleKeys keys;
   KeyCommands commands(*server);
+  // The keeper on its own thread: making a participant must not hold up the keys.
+  std::jthread keeping([&keeper](const std::stop_token& stop) {
+    while (!stop.stop_requested()) {
+      keeper.tick(ground::Station::now_ns());
+      std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+  });
   int shown_reports = 0;
   std::uint16_t shown_heard = 0xFFFF;
   auto next_draw = std::chrono::steady_clock::now();
@@ -104,7 +128,6 @@ void run_console(const ConsoleArgs& args) {
     if (key == ConsoleKey::clear_fault)
       commands.send(ground::CommandKind::clear_fault, expected, args.ground.timeout_s);
     const std::int64_t now = ground::Station::now_ns();
-    keeper.tick(now);
     const auto [last, reports] = commands.last();
     if (keys.terminal()) {
       if (std::chrono::steady_clock::now() < next_draw && reports == shown_reports) continue;

@@ -25,7 +25,7 @@ void add_revoke(CLI::App& security) {
       "(crl.pem) in every enclave, and give the enclave a new identity for its replacement");
   cmd->add_option("name", args->name, "Enclave: ground, listener or endcap_NN (or /tensegrity/...)")->required();
   cmd->add_option("dir", args->dir, "Keystore folder (default as for init)");
-  cmd->add_option("--days", args->days, "Validity of the new certificate and the list, days")
+  cmd->add_option("--days", args->days, "Validity of the new certificate, days")
       ->check(CLI::Range(1, 36500))
       ->capture_default_str();
   cmd->callback([args] {
@@ -41,7 +41,8 @@ void add_revoke(CLI::App& security) {
                 r.revoked_serial.c_str(), r.revoked_total, r.new_serial.c_str());
     std::printf(
         "copy crl.pem (%s/public/crl.pem, the same in every enclave) to every board, and the new %s enclave "
-        "to the replacement board: until a participant has the list it still accepts the old identity\n",
+        "to the replacement board, and restart what runs (consoles, HIL, end caps): a participant reads the list when "
+        "it starts, and until then it still accepts the old identity\n",
         dir.string().c_str(), enclave.c_str());
   });
 }

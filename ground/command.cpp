@@ -87,7 +87,7 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
     }
     std::int64_t wake = std::min(next_send, deadline);
     if (options.keep_going) wake = std::min(wake, Station::now_ns() + kPreemptCheckNs);
-    station.wait_for_acks(wake);
+    station.wait_for_command_acks(wake);
     const std::int64_t arrived = Station::now_ns();
     for (const auto& ack : station.take_command_acks()) {
       if (ack.seq() != cmd.seq()) continue;

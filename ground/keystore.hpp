@@ -50,8 +50,9 @@ bool ensure_keystore(const std::filesystem::path& dir);
 // KEYSTORE/private/ca.db, the signed list in KEYSTORE/public/crl.pem), the list is
 // copied into every enclave as crl.pem (SROS2's name; Fast DDS's identity_crl), and
 // the enclave gets a new key and certificate for its replacement board. Every
-// participant given the new crl.pem refuses the old certificate; boards must get
-// the file (it is the same in every enclave). Throws KeystoreError.
+// participant started with the new crl.pem refuses the old certificate; boards must
+// get the file (it is the same in every enclave). Safe to rerun after a failure.
+// Throws KeystoreError.
 struct Revocation {
   std::string revoked_serial;  // as openssl prints it, hex
   std::string new_serial;

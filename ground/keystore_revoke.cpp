@@ -39,15 +39,20 @@ void replace_file(const fs::path& from, const fs::path& to) {
 
 // The database `openssl ca` keeps (index of revoked certificates, CRL number) and a
 // configuration naming it.
-fs::path ca_database(const fs::path& dir, int valid_days) {
+// The list itself is valid this long whatever the certificates' validity: a list
+// past its next-update date would stop every participant that holds it.
+constexpr int kListValidDays = 3650;
+
+fs::path ca_database(const fs::path& dir) {
   const fs::path db = dir / "private" / "ca.db";
   fs::create_directories(db);
   fs::permissions(db, fs::perms::owner_all);
   if (!fs::exists(db / "index.txt")) write_text(db / "index.txt", "");
   if (!fs::exists(db / "crlnumber")) write_text(db / "crlnumber", "1000\n");
-  write_text(db / "openssl.cnf", "[ ca ]\ndefault_ca = tensegrity\n[ tensegrity ]\ndatabase = " +
-                                     (db / "index.txt").string() + "\ncrlnumber = " + (db / "crlnumber").string() +
-                                     "\ndefault_md = sha256\ndefault_crl_days = " + std::to_string(valid_days) + "\n");
+  write_text(db / "openssl.cnf",
+             "[ ca ]\ndefault_ca = tensegrity\n[ tensegrity ]\ndatabase = " + (db / "index.txt").string() +
+                 "\ncrlnumber = " + (db / "crlnumber").string() +
+                 "\ndefault_md = sha256\ndefault_crl_days = " + std::to_string(kListValidDays) + "\n");
   return db;
 }
 
@@ -80,7 +85,7 @@ Revocation revoke_enclave(const fs::path& dir_in, const std::string& enclave, in
   } catch (const std::exception& e) {
     throw KeystoreError(e.what());
   }
-  const fs::path db = ca_database(dir, valid_days);
+  const fs::path db = ca_database(dir);
   const fs::path log = db / "openssl.log", cnf = db / "openssl.cnf";
   const std::string ca_cert = (dir / "public" / "ca.cert.pem").string();
   const std::string ca_key = (dir / "private" / "ca.key.pem").string();
@@ -88,9 +93,20 @@ Revocation revoke_enclave(const fs::path& dir_in, const std::string& enclave, in
 
   Revocation out;
   out.revoked_serial = serial_of(enclave_dir / "cert.pem", log);
-  openssl({"ca", "-config", cnf.string(), "-keyfile", ca_key, "-cert", ca_cert, "-revoke",
-           (enclave_dir / "cert.pem").string()},
-          log);
+  // The replacement identity first, aside: if anything below fails, the enclave
+  // still holds a matching key and certificate, and a rerun finishes the job.
+  const fs::path fresh = db / "reissue";
+  fs::remove_all(fresh);
+  fs::create_directories(fresh);
+  out.new_serial = random_serial();
+  issue_identity(dir, enclave, fresh, out.new_serial, valid_days, log);
+  // Already on the list (a rerun after a failure): not revoked twice, which openssl refuses.
+  const std::string listed = "\t" + out.revoked_serial + "\tunknown\t";
+  if (read_text(db / "index.txt").find(listed) == std::string::npos) {
+    openssl({"ca", "-config", cnf.string(), "-keyfile", ca_key, "-cert", ca_cert, "-revoke",
+             (enclave_dir / "cert.pem").string()},
+            log);
+  }
   openssl({"ca", "-config", cnf.string(), "-keyfile", ca_key, "-cert", ca_cert, "-gencrl", "-out",
            (db / "crl.pem").string()},
           log);
@@ -98,12 +114,8 @@ Revocation revoke_enclave(const fs::path& dir_in, const std::string& enclave, in
   for (const std::string& name : msgs::all_enclaves()) {
     replace_file(dir / "public" / "crl.pem", msgs::enclave_dir(dir, name) / "crl.pem");
   }
-  // The replacement board's identity, made aside and moved in whole.
-  const fs::path fresh = db / "reissue";
-  fs::remove_all(fresh);
-  fs::create_directories(fresh);
-  out.new_serial = random_serial();
-  issue_identity(dir, enclave, fresh, out.new_serial, valid_days, log);
+  // Key and certificate change together: the key first (a participant started in
+  // between fails its own check and says so), the certificate right after.
   fs::rename(fresh / "key.pem", enclave_dir / "key.pem");
   fs::rename(fresh / "cert.pem", enclave_dir / "cert.pem");
   fs::remove_all(fresh);

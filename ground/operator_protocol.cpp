@@ -31,7 +31,6 @@ const char* relayed_name(CommandKind kind) {
   }
   throw std::invalid_argument("operator link: a console relays estop, stop and clear-fault only");
 }
-constexpr double kMaxTimeoutS = 600.0;
 constexpr std::uint8_t kLastReason = static_cast<std::uint8_t>(fw::comms::CommandReason::bad_time);
 
 Reader top_level(const json& j, const char* what) {
@@ -94,7 +93,7 @@ OperatorRequest decode_request(const std::string& line) {
   out.kind = read_kind(r);
   out.endcap_mask = read_mask(r);
   out.timeout_s = r.positive("timeout_s", 0.0, true);
-  if (out.timeout_s > kMaxTimeoutS) r.fail("timeout_s", "must be <= 600 s");
+  if (out.timeout_s > kMaxOperatorTimeoutS) r.fail("timeout_s", "must be <= 3600 s");
   return out;
 }
 

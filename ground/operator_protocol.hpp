@@ -16,6 +16,8 @@
 namespace tensegrity::ground {
 
 inline constexpr const char* kOperatorFormat = "tensegrity-operator/1";
+// The longest deadline a console takes for one command.
+inline constexpr double kMaxOperatorTimeoutS = 3600.0;
 
 class OperatorLinkError : public std::runtime_error {
  public:

@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <system_error>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -21,24 +23,25 @@ constexpr std::size_t kMaxRequestBytes = 4096;
 // A client sends its one line at once; one that does not is not kept.
 constexpr std::chrono::milliseconds kRequestTimeout{2000};
 
-// The socket's folder: made 0700, or, if it exists, refused unless only its owner
-// (this user) may enter it; a socket's own mode is not enough on every system.
+// The socket's folder: made 0700 if missing; an existing one must already be
+// private (a folder someone else controls could swap the socket or the folder).
 void private_folder(const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
   struct stat st {};
-  if (::stat(folder.c_str(), &st) != 0) throw OperatorLinkError(folder.string() + ": cannot stat the socket's folder");
-  if (st.st_uid != ::geteuid()) {
-    throw OperatorLinkError(folder.string() + ": the socket's folder belongs to another user");
+  if (::lstat(folder.c_str(), &st) != 0 && errno == ENOENT) {
+    std::filesystem::create_directories(folder);
+    if (::chmod(folder.c_str(), 0700) != 0) throw OperatorLinkError(folder.string() + ": cannot chmod 700");
   }
-  if ((st.st_mode & 077) != 0 && ::chmod(folder.c_str(), 0700) != 0) {
-    throw OperatorLinkError(folder.string() + ": cannot make the socket's folder private (chmod 700)");
+  try {
+    check_private_folder(folder);
+  } catch (const std::runtime_error& e) {
+    throw OperatorLinkError(std::string("the console's socket folder ") + e.what());
   }
 }
 
 }  // namespace
 
 OperatorServer::OperatorServer(StationSource station, std::filesystem::path socket_path)
-    : station_(std::move(station)), socket_path_(std::move(socket_path)) {
+    : station_(std::move(station)), socket_path_(std::filesystem::absolute(socket_path).lexically_normal()) {
   if (!station_) throw std::invalid_argument("operator server: no station");
   private_folder(socket_path_.parent_path());
   try {
@@ -50,15 +53,20 @@ OperatorServer::OperatorServer(StationSource station, std::filesystem::path sock
 }
 
 OperatorServer::~OperatorServer() {
+  shutdown();
+  std::lock_guard lock(connections_mutex_);
+  connections_.clear();  // joins each: their commands end early (stopping_)
+}
+
+void OperatorServer::shutdown() {
   stopping_ = true;
   acceptor_.request_stop();
-  acceptor_.join();
-  {
-    std::lock_guard lock(connections_mutex_);
-    connections_.clear();  // joins each: their commands end early (stopping_)
+  if (acceptor_.joinable()) acceptor_.join();
+  // Closed at once, so a tool finds no console and speaks itself instead of waiting.
+  if (const int fd = listen_fd_.exchange(-1); fd >= 0) {
+    ::unlink(socket_path_.c_str());
+    ::close(fd);
   }
-  ::close(listen_fd_);
-  ::unlink(socket_path_.c_str());
 }
 
 CommandReport OperatorServer::run(const OperatorRequest& request) {
@@ -66,25 +74,39 @@ CommandReport OperatorServer::run(const OperatorRequest& request) {
   if (estop) ++estops_waiting_;
   std::unique_lock lock(command_mutex_);
   if (estop) --estops_waiting_;
+  if (stopping_) throw OperatorLinkError("the console is stopping");
   CommandOptions options;
   options.endcap_mask = request.endcap_mask;
   options.timeout_s = request.timeout_s;
+  // Any command in flight, an older estop included, yields to a newer estop; the
+  // end caps an estop had not yet heard from pass to the one that took over.
+  options.keep_going = [this] { return estops_waiting_.load() == 0 && !stopping_.load(); };
   if (estop) {
     options.retry_interval_s = kEstopRetryIntervalS;
-    options.keep_going = [this] { return !stopping_.load(); };
-  } else {
-    options.keep_going = [this] { return estops_waiting_.load() == 0 && !stopping_.load(); };
+    options.endcap_mask = static_cast<std::uint16_t>(options.endcap_mask | std::exchange(estop_handover_mask_, 0));
   }
-  const std::shared_ptr<Station> station = station_();
-  return send_command(*station, request.kind, 0, options);
+  CommandReport report;
+  {
+    const std::shared_ptr<Station> station = station_();
+    report = send_command(*station, request.kind, 0, options);
+  }
+  if (estop && report.preempted) {
+    for (const int e : report.missing())
+      estop_handover_mask_ = static_cast<std::uint16_t>(estop_handover_mask_ | (1U << e));
+  }
+  return report;
 }
 
 void OperatorServer::accept_loop(const std::stop_token& stop) {
+  const int listen_fd = listen_fd_.load();
   while (!stop.stop_requested()) {
-    pollfd p{listen_fd_, POLLIN, 0};
+    pollfd p{listen_fd, POLLIN, 0};
     if (::poll(&p, 1, 100) <= 0) continue;
-    UniqueFd fd(::accept4(listen_fd_, nullptr, nullptr, SOCK_CLOEXEC));
-    if (!fd) continue;
+    UniqueFd fd(::accept4(listen_fd, nullptr, nullptr, SOCK_CLOEXEC));
+    if (!fd) {  // out of descriptors, say: do not spin
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      continue;
+    }
     reap_finished();
     const long uid = peer_uid(fd.get());
     std::lock_guard lock(connections_mutex_);
@@ -101,10 +123,15 @@ void OperatorServer::accept_loop(const std::stop_token& stop) {
       continue;
     }
     Connection& c = connections_.emplace_back();
-    c.thread = std::jthread([this, &c, raw = fd.release()] {
-      serve(raw);
-      c.done = true;
-    });
+    try {
+      c.thread = std::jthread([this, &c, raw = fd.get()] {
+        serve(raw);
+        c.done = true;
+      });
+      (void)fd.release();                 // the thread owns it now
+    } catch (const std::system_error&) {  // no thread: the descriptor closes with `fd`
+      connections_.pop_back();
+    }
   }
 }
 

@@ -7,8 +7,9 @@
 // each peer's uid is checked (SO_PEERCRED) against this process's, so a command
 // still comes from someone who holds the ground identity's key, not from anyone on
 // the machine. One thread per connection (at most kMaxConnections); commands run
-// one at a time, and an emergency stop preempts a stop or clear-fault in flight
-// (its acknowledgement wait, not its effect: the preempted command was already sent).
+// one at a time, and an emergency stop preempts whatever is in flight, an older
+// estop too (its acknowledgement wait, not its effect: the preempted command was
+// already sent); the end caps an older estop had not heard from join the newer one.
 #pragma once
 
 #include <atomic>
@@ -41,8 +42,9 @@ class OperatorServer {
   // the console's own keys do.
   CommandReport run(const OperatorRequest& request);
 
-  // Commands in flight end at their next check (a few ms); new ones return at once.
-  void shutdown() { stopping_ = true; }
+  // Stops accepting (the socket removed), ends commands in flight at their next
+  // check (a few ms); new ones are refused.
+  void shutdown();
 
   const std::filesystem::path& socket_path() const { return socket_path_; }
   std::uint64_t served() const { return served_.load(); }
@@ -55,10 +57,11 @@ class OperatorServer {
 
   StationSource station_;
   std::filesystem::path socket_path_;
-  int listen_fd_ = -1;
+  std::atomic<int> listen_fd_{-1};
   std::mutex command_mutex_;            // one command at a time
   std::atomic<int> estops_waiting_{0};  // > 0: a command in flight yields
   std::atomic<bool> stopping_{false};
+  std::uint16_t estop_handover_mask_ = 0;  // under command_mutex_
   std::atomic<std::uint64_t> served_{0};
   std::atomic<std::uint64_t> refused_{0};
   std::mutex connections_mutex_;

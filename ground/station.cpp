@@ -178,12 +178,18 @@ std::vector<msg::CommandAck_> Station::take_command_acks() {
   return std::exchange(command_acks_, {});
 }
 
-void Station::wait_for_acks(std::int64_t deadline_ns) {
+void Station::wait_for_policy_acks(std::int64_t deadline_ns) {
   std::unique_lock lock(mutex_);
   const std::int64_t wait = deadline_ns - now_ns();
   if (wait <= 0) return;
-  changed_.wait_for(lock, std::chrono::nanoseconds(wait),
-                    [this] { return !policy_acks_.empty() || !command_acks_.empty(); });
+  changed_.wait_for(lock, std::chrono::nanoseconds(wait), [this] { return !policy_acks_.empty(); });
+}
+
+void Station::wait_for_command_acks(std::int64_t deadline_ns) {
+  std::unique_lock lock(mutex_);
+  const std::int64_t wait = deadline_ns - now_ns();
+  if (wait <= 0) return;
+  changed_.wait_for(lock, std::chrono::nanoseconds(wait), [this] { return !command_acks_.empty(); });
 }
 
 std::array<EndcapStatus, kEndcapCount> Station::snapshot() const {
@@ -245,6 +251,7 @@ void StationListeners::policy_acks(Station& s, dds::DataReader* r) {
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
     }
+    if (s.policy_acks_.size() >= Station::kMaxPendingAcks) s.policy_acks_.erase(s.policy_acks_.begin());
     s.policy_acks_.push_back(ack);
     s.changed_.notify_all();
   }
@@ -261,6 +268,7 @@ void StationListeners::command_acks(Station& s, dds::DataReader* r) {
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
     }
+    if (s.command_acks_.size() >= Station::kMaxPendingAcks) s.command_acks_.erase(s.command_acks_.begin());
     s.command_acks_.push_back(ack);
     s.changed_.notify_all();
   }

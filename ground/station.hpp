@@ -73,8 +73,13 @@ class Station {
   // Acks received since the last call (any thread may wait, one should take).
   std::vector<msg::PolicyAck_> take_policy_acks();
   std::vector<msg::CommandAck_> take_command_acks();
-  // Returns when an ack arrives or at `deadline_ns` (host clock).
-  void wait_for_acks(std::int64_t deadline_ns);
+  // Return when an ack of that kind is waiting or at `deadline_ns` (host clock). Each
+  // waits for its own kind: a station that never takes policy acks (the operator
+  // console's) must not have its command waits woken for good by one.
+  void wait_for_policy_acks(std::int64_t deadline_ns);
+  void wait_for_command_acks(std::int64_t deadline_ns);
+  // Acks nobody takes are kept up to this many of each kind (the oldest dropped).
+  static constexpr std::size_t kMaxPendingAcks = 1024;
 
   std::array<EndcapStatus, kEndcapCount> snapshot() const;
   // True once every end cap in `mask` sent a heartbeat (and, with `synced`, says

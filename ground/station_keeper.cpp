@@ -43,6 +43,10 @@ std::uint16_t StationKeeper::heard(const Station& station, std::uint16_t expecte
 }
 
 void StationKeeper::tick(std::int64_t now_ns) {
+  // Stations leaving are destroyed after the lock is released (a participant takes
+  // a while to close), so that current() never waits for one.
+  std::shared_ptr<Station> leaving;
+  std::unique_ptr<Station> dropped;
   std::unique_lock lock(mutex_);
   const std::uint16_t now_heard = heard(*current_, options_.expected, now_ns, options_.fresh_s);
   if ((now_heard & ~last_heard_) != 0) last_growth_ns_ = now_ns;
@@ -54,17 +58,17 @@ void StationKeeper::tick(std::int64_t now_ns) {
     const std::uint16_t got = heard(*candidate_, options_.expected, now_ns, options_.fresh_s);
     const bool trial_over = now_ns - candidate_since_ns_ > static_cast<std::int64_t>(options_.trial_s * 1e9);
     if (got == options_.expected || (trial_over && std::popcount(got) > std::popcount(now_heard))) {
-      current_ = std::shared_ptr<Station>(std::move(candidate_));  // the old one ends with its last user
+      leaving = std::exchange(current_, std::shared_ptr<Station>(std::move(candidate_)));
       ++rejoins_;
       stall_s_ = options_.stall_s;
       last_heard_ = got;
       last_growth_ns_ = now_ns;
     } else if (trial_over) {
-      candidate_.reset();
+      dropped = std::move(candidate_);
       stall_s_ = std::min(2.0 * stall_s_, options_.max_stall_s);
       last_growth_ns_ = now_ns;
     }
-    return;
+    return;  // `lock` is released before `leaving` and `dropped` go
   }
   const bool stalled =
       now_heard != options_.expected && now_ns - last_growth_ns_ > static_cast<std::int64_t>(stall_s_ * 1e9);

@@ -75,6 +75,16 @@ UniqueFd listen_unix(const std::filesystem::path& path, int backlog) {
   return fd;
 }
 
+void check_private_folder(const std::filesystem::path& folder) {
+  struct stat st {};
+  if (::lstat(folder.c_str(), &st) != 0) throw std::runtime_error(system_error(folder, "lstat"));
+  if (!S_ISDIR(st.st_mode)) throw std::runtime_error(folder.string() + ": not a directory (a link is not accepted)");
+  if (st.st_uid != ::geteuid()) throw std::runtime_error(folder.string() + ": belongs to another user");
+  if ((st.st_mode & 077) != 0) {
+    throw std::runtime_error(folder.string() + ": others may enter it (chmod 700 it, or pick a private folder)");
+  }
+}
+
 long peer_uid(int fd) {
   ucred cred{};
   socklen_t size = sizeof cred;

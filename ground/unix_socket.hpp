@@ -33,6 +33,10 @@ UniqueFd connect_unix(const std::filesystem::path& path);
 // Listening on `path` (mode 0600; a stale socket there is replaced). Throws
 // std::runtime_error naming the path when a live listener holds it or it is not a socket.
 UniqueFd listen_unix(const std::filesystem::path& path, int backlog);
+// Throws std::runtime_error naming the folder unless it is a real directory (not a
+// symbolic link) owned by this user that nobody else may enter (no group or other
+// permission bits): what keeps another user's socket from passing as ours.
+void check_private_folder(const std::filesystem::path& folder);
 // The uid of the peer of a connected socket (SO_PEERCRED), or -1.
 long peer_uid(int fd);
 // The peer closed the connection before sending anything (a liveness probe).

@@ -56,7 +56,7 @@ UploadReport upload(Station& station, const std::vector<msg::PolicyTable_>& tabl
       }
       next_send = now + retry_ns;
     }
-    station.wait_for_acks(std::min(next_send, deadline));
+    station.wait_for_policy_acks(std::min(next_send, deadline));
     const std::int64_t arrived = Station::now_ns();
     for (const auto& ack : station.take_policy_acks()) {
       for (std::size_t i = 0; i < tables.size(); ++i) {

@@ -95,6 +95,13 @@ TEST_F(Keystore, RevokingListsTheOldCertificateEverywhereAndIssuesANewOne) {
   }
   EXPECT_TRUE(keystore_complete(ks));
   EXPECT_THROW(revoke_enclave(ks, "/tensegrity/endcap_12"), KeystoreError);
+  // A run that failed after listing but before the swap left the old certificate
+  // in place: a rerun finishes the job instead of stopping at "already revoked".
+  const fs::path e7dir = msgs::enclave_dir(ks, e7);
+  fs::copy_file(old7, e7dir / "cert.pem", fs::copy_options::overwrite_existing);
+  const Revocation rerun = revoke_enclave(ks, e7);
+  EXPECT_EQ(rerun.revoked_total, 2);
+  EXPECT_EQ(sh(check + (e7dir / "cert.pem").string()), 0);
 }
 
 TEST_F(Keystore, AnExistingKeystoreIsKeptUnlessReplaced) {

@@ -3,11 +3,12 @@
 // validation, the socket's rules (one console per socket, a dead one's socket
 // replaced, a private folder), an estop that preempts a stop in flight, and the
 // program end to end: `tensegrity estop` sent through a running console to three
-// end-cap nodes (comms_test_node). Domains 180-184.
+// end-cap nodes (comms_test_node). Domains 180-184 and 186.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 #include <future>
 #include <random>
@@ -86,6 +87,7 @@ class ConsoleLink : public ::testing::Test {
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("console_" + std::to_string(std::random_device{}()));
     fs::create_directories(dir_);
+    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::replace);  // a console's folder is private
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
@@ -106,6 +108,10 @@ TEST_F(ConsoleLink, OneListenerPerSocketAndADeadOnesSocketIsReplaced) {
   EXPECT_NO_THROW(listen_unix(path, 4));
   std::ofstream(dir_ / "plain") << "x";
   EXPECT_THROW(listen_unix(dir_ / "plain", 4), std::runtime_error);
+  // In a folder others may enter, whatever answers is not taken for the console.
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec,
+                  fs::perm_options::replace);
+  EXPECT_THROW(ask_console(path, OperatorRequest{}), OperatorLinkError);
 }
 
 TEST_F(ConsoleLink, TheServerMakesItsFolderPrivateAndRefusesABadRequestByName) {
@@ -118,6 +124,8 @@ TEST_F(ConsoleLink, TheServerMakesItsFolderPrivateAndRefusesABadRequestByName) {
   const fs::path path = dir_ / "sub" / "c.sock";
   OperatorServer server([station] { return station; }, path);
   EXPECT_EQ(fs::status(path.parent_path()).permissions() & fs::perms::all, fs::perms::owner_all);
+  fs::create_directories(dir_ / "open");  // 0755: the server does not take it over
+  EXPECT_THROW(OperatorServer([station] { return station; }, dir_ / "open" / "c.sock"), OperatorLinkError);
   EXPECT_THROW(OperatorServer([station] { return station; }, path), OperatorLinkError);  // one console per socket
 
   UniqueFd fd = connect_unix(path);
@@ -151,7 +159,8 @@ TEST_F(ConsoleLink, AnEstopPreemptsAStopInFlight) {
   const double elapsed_s = static_cast<double>(Station::now_ns() - t0) / 1e9;
 
   EXPECT_TRUE(stopped.preempted);
-  EXPECT_EQ(stopped.missing(), std::vector<int>{3});
+  const std::vector<int> missing = stopped.missing();
+  EXPECT_NE(std::find(missing.begin(), missing.end(), 3), missing.end());
   EXPECT_LT(elapsed_s, 15.0) << "the stop ran to its 20 s deadline: the estop did not take over";
   ASSERT_TRUE(estop.has_value());
   EXPECT_TRUE(estop->error.empty()) << estop->error;
@@ -161,6 +170,28 @@ TEST_F(ConsoleLink, AnEstopPreemptsAStopInFlight) {
   for (const auto& r : estop->report.results) worst = std::max(worst, r.latency_s);
   std::printf("MEASURE console estop after preempting a stop: last ack %.1f ms, stop ended after %.2f s\n", worst * 1e3,
               elapsed_s);
+}
+
+// An estop for end cap 3 (absent) is preempted by a newer estop for end cap 0: the
+// newer one takes end cap 3 over, so no end cap an estop was meant for is dropped.
+TEST_F(ConsoleLink, ANewerEstopTakesOverTheEndcapsAnOlderOneMissed) {
+  constexpr int kDomain = 186;
+  Subprocess nodes({COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", "0-2"}, dir_ / "nodes.out",
+                   dir_ / "nodes.err");
+  ASSERT_TRUE(nodes.wait_for_output("READY", std::chrono::seconds(20)));
+  StationOptions o;
+  o.domain = kDomain;
+  auto station = std::make_shared<Station>(o);
+  ASSERT_TRUE(station->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000));
+  OperatorServer server([station] { return station; }, dir_ / "c.sock");
+  auto older = std::async(std::launch::async, [&] { return server.run({CommandKind::emergency_stop, 0b1000, 20.0}); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const CommandReport newer = server.run({CommandKind::emergency_stop, 0b0001, 2.0});
+  const CommandReport first = older.get();
+  EXPECT_TRUE(first.preempted);
+  ASSERT_EQ(newer.results.size(), 2U) << format_command_report(newer);
+  EXPECT_TRUE(newer.results[0].accepted) << "end cap 0";
+  EXPECT_EQ(newer.missing(), std::vector<int>{3}) << "end cap 3 was carried over, and is absent";
 }
 
 // A station that hears nobody (here: made on another domain, as a stalled security
@@ -180,10 +211,10 @@ TEST_F(ConsoleLink, TheKeeperReplacesAStationThatHearsNobody) {
   StationKeeper::Options keep;
   keep.expected = 0b1111;  // end cap 3 never answers
   keep.stall_s = 0.5;
-  keep.trial_s = 1.5;
+  keep.trial_s = 5.0;  // room for a fresh participant's discovery on a loaded machine
   StationKeeper keeper(make, keep);
   const std::shared_ptr<Station> first = keeper.current();
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (keeper.rejoins() == 0 && std::chrono::steady_clock::now() < until) {
     keeper.tick(Station::now_ns());
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
