@@ -75,6 +75,18 @@ class SecureDds : public ::testing::Test {
     o.publish_heartbeat = serve_time;
     return std::make_unique<Station>(o);
   }
+  // A station that heard the end caps of `mask`. Fast DDS 2.9.1's handshake now and
+  // then stalls for good (docs/security.md), and the product rejoins then (the HIL,
+  // the console, the command tools): so does the test, once, after 15 s.
+  static std::unique_ptr<Station> joined(int domain, const fs::path& enclave_dir, std::uint16_t mask, bool synced,
+                                         bool serve_time = true) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      auto s = station(domain, enclave_dir, serve_time);
+      if (s->wait_for_endcaps(mask, synced, after_s(15))) return s;
+      std::printf("a secured handshake stalled: a fresh participant, as the product makes one\n");
+    }
+    return nullptr;
+  }
   static CommandReport command(Station& s, CommandKind kind, double timeout_s) {
     CommandOptions o;
     o.endcap_mask = kThree;
@@ -101,9 +113,9 @@ fs::path SecureDds::root_;
 TEST_F(SecureDds, TheGroundIdentityIsHeardAndObeyed) {
   constexpr int kDomain = 175;
   start_nodes(kDomain);
-  auto ground = station(kDomain, enclave("keystore", msgs::Role::ground));
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE(ground->wait_for_endcaps(kThree, true, after_s(30))) << "secured discovery + time sync";
+  auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, true);
+  ASSERT_TRUE(ground) << "secured discovery + time sync";
   std::printf("MEASURE secured discovery and time sync of 3 end caps: %.0f ms\n",
               std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   UploadOptions uo;
@@ -122,8 +134,8 @@ TEST_F(SecureDds, AnUnauthenticatedOrForeignHostIsNotHeard) {
   constexpr int kDomain = 176;
   start_nodes(kDomain);
   // A watcher with the right identity that neither serves time nor commands.
-  auto watcher = station(kDomain, enclave("keystore", msgs::Role::ground), false);
-  ASSERT_TRUE(watcher->wait_for_endcaps(kThree, false, after_s(30)));
+  auto watcher = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false, false);
+  ASSERT_TRUE(watcher);
   for (const fs::path& who : {fs::path(), enclave("foreign", msgs::Role::ground)}) {
     SCOPED_TRACE(who.empty() ? "unauthenticated" : "foreign CA");
     auto intruder = station(kDomain, who);
@@ -178,8 +190,8 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
   namespace dds = eprosima::fastdds::dds;
   namespace m = tensegrity_msgs::msg::dds_;
   start_nodes(kDomain);
-  auto ground = station(kDomain, enclave("keystore", msgs::Role::ground));
-  ASSERT_TRUE(ground->wait_for_endcaps(kThree, false, after_s(30)));
+  auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false);
+  ASSERT_TRUE(ground);
   dds::DomainParticipant* impostor =
       msgs::create_participant(kDomain, "impostor", nullptr, enclave("keystore", msgs::Role::endcap, 1));
   struct Deleter {
@@ -237,23 +249,20 @@ TEST_F(SecureDds, ARevokedIdentityIsRefusedByEveryoneGivenTheList) {
   const auto thief = node("1", "lost");        // end cap 1's old identity, no list
   ASSERT_TRUE(others->wait_for_output("READY", std::chrono::seconds(30)));
   ASSERT_TRUE(thief->wait_for_output("READY", std::chrono::seconds(30)));
-  auto ground = station(kDomain, enclave("revoked", msgs::Role::ground));
-  ASSERT_TRUE(ground->wait_for_endcaps(0b101, false, after_s(30))) << "the boards in good standing";
+  auto ground = joined(kDomain, enclave("revoked", msgs::Role::ground), 0b101, false);
+  ASSERT_TRUE(ground) << "the boards in good standing";
   EXPECT_FALSE(ground->wait_for_endcaps(0b010, false, after_s(8))) << "the revoked identity was heard";
   // The control: a ground without the list hears the old identity, so the list is
   // what refused it (not a broken node).
-  auto unaware = station(kDomain, enclave("lost", msgs::Role::ground), /*serve_time=*/false);
-  EXPECT_TRUE(unaware->wait_for_endcaps(0b010, false, after_s(30))) << "the old identity never worked at all";
+  auto unaware = joined(kDomain, enclave("lost", msgs::Role::ground), 0b010, false, /*serve_time=*/false);
+  EXPECT_TRUE(unaware) << "the old identity never worked at all";
   // The replacement board's new identity is heard.
   const auto replacement = node("1", "revoked");
   ASSERT_TRUE(replacement->wait_for_output("READY", std::chrono::seconds(30)));
-  const auto t0 = std::chrono::steady_clock::now();
-  bool heard_new = false;
-  while (!heard_new && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(30)) {
-    // Heard through the listed ground only if the new certificate authenticates.
-    heard_new = ground->wait_for_endcaps(0b010, false, after_s(0.5));
-  }
-  EXPECT_TRUE(heard_new) << "the replacement identity was not heard";
+  // Heard by a ground that has the list only if the new certificate authenticates.
+  ground.reset();
+  EXPECT_TRUE(joined(kDomain, enclave("revoked", msgs::Role::ground), 0b010, false))
+      << "the replacement identity was not heard";
 }
 
 TEST_F(SecureDds, AMissingEnclaveFileIsNamed) {
