@@ -66,6 +66,11 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
     return false;
   }
   const bool none_acked = reply->report.missing().size() == reply->report.results.size();
+  std::uint16_t reported = 0;
+  for (const auto& r : reply->report.results) reported = static_cast<std::uint16_t>(reported | (1U << r.endcap));
+  if (reply->error.empty() && (reported & request.endcap_mask) != request.endcap_mask) {
+    reply->error = "its report leaves out end caps this command addresses";
+  }
   if (!reply->error.empty() || (reply->report.preempted && none_acked)) {
     // Refused (busy, stopping) or ended before any end cap answered: the command may
     // not have gone out, so on the default socket the tool sends it itself.
