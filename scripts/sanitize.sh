@@ -6,9 +6,9 @@
 #   tsan  ThreadSanitizer on the threads that share memory: the control loop's
 #         mailbox, the end cap's DDS node (end caps in comms_test_node processes
 #         against ground participants) and the HIL's UDP hub
-#   ci    what CI runs (scripts/test.sh), about 4 minutes on 2 cores: asan on the
+#   ci    what CI runs (scripts/test.sh), about 6-8 minutes on 2 cores: asan on the
 #         firmware's unit tests (core, drivers, hal, app with its end-cap process
-#         tests, mailbox, comms), tsan on the mailbox
+#         tests, mailbox, comms), tsan on the mailbox and the HIL's unit tests (hub)
 # Usage: scripts/sanitize.sh [asan] [tsan] [ci]   (default: asan tsan)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -33,8 +33,8 @@ run_ci() {
     comms_tests
   ctest --preset asan -L "^($firmware)\$"
   cmake --preset tsan >/dev/null
-  cmake --build --preset tsan -j "$jobs" --target mailbox_tests
-  ctest --preset tsan -L '^mailbox_tests$'
+  cmake --build --preset tsan -j "$jobs" --target mailbox_tests hil_unit_tests
+  ctest --preset tsan -L '^(mailbox_tests|hil_unit_tests)$'
 }
 
 run_tsan() {
