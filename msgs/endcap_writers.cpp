@@ -51,11 +51,21 @@ void EndcapWriters::on_publisher_discovery(dds::DomainParticipant*, rtps::Writer
     endcap_of_writer_.erase(guid);
     return;
   }
-  // Discovered or changed QoS: what its partitions say now.
   const auto& partitions = info.info.m_qos.m_partition;
   int endcap = -1;
   if (partitions.size() == 1) endcap = endcap_of_partition(partitions.begin()->name());
-  endcap_of_writer_[guid] = endcap;
+  const auto [it, first] = endcap_of_writer_.try_emplace(guid, endcap);
+  if (first || it->second == endcap) return;
+  // Partition is a mutable QoS, and Fast DDS 2.9.1 checks a remote writer's
+  // partitions against its permissions when it matches the writer, not when a QoS
+  // update moves it (SecureDds.AnEndcapIdentityCannotMoveItsWritersIntoAnotherPartition
+  // found an end cap's writer moved into another's partition accepted). An end cap's
+  // writers never move, so one that does speaks for no end cap from then on.
+  if (it->second >= 0) {
+    std::fprintf(stderr, "REFUSED from now on: a writer of end cap %d moved to partition %s\n", it->second,
+                 partitions.size() == 1 ? partitions.begin()->name() : "(several or none)");
+  }
+  it->second = -1;
 }
 
 int EndcapWriters::endcap_of(const dds::SampleInfo& info) const {

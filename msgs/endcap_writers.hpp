@@ -6,8 +6,10 @@
 // (msgs/security.cpp), and Fast DDS checks a remote writer's partitions against its
 // permissions before it matches it. A reader of reports listens to every end cap's
 // partition ("endcap_*") and remembers, for each writer it discovers, the end cap
-// its partition names; a sample whose id is not its writer's is refused. So one end
-// cap's identity cannot speak for another. docs/security.md.
+// its partition names; a sample whose id is not its writer's is refused. A writer
+// whose partition changes after discovery is refused from then on (Fast DDS checks
+// permissions when it matches a writer, not when its QoS changes). So one end cap's
+// identity cannot speak for another. docs/security.md.
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>

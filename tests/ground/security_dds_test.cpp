@@ -5,7 +5,7 @@
 // unauthenticated participant, one of another CA, and one holding an end cap's
 // identity may not upload, start, clear a fault or answer a time sync; an end cap's
 // identity may not speak for another end cap; a revoked identity is refused.
-// Domains 175-179, 185.
+// Domains 175-179, 185, 187.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -229,6 +229,53 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
   EXPECT_GE(ground->impostor_samples(), 2U) << "the impostor's samples never reached the ground";
   for (const auto& a : ground->take_command_acks()) EXPECT_NE(a.seq(), 424242U) << "a forged ack was taken";
   EXPECT_NE(ground->snapshot()[2].heartbeat.seq(), hb.seq()) << "end cap 2's status shows the impostor's heartbeat";
+}
+
+// Partition is a mutable QoS: an end cap's identity that made its writers in its own
+// partition may move its publisher to another end cap's afterwards, a path that
+// Fast DDS's check at writer creation does not see. What end cap 1's identity then
+// sends under end cap 2's id must still never count as end cap 2's.
+TEST_F(SecureDds, AnEndcapIdentityCannotMoveItsWritersIntoAnotherPartition) {
+  constexpr int kDomain = 187;
+  namespace dds = eprosima::fastdds::dds;
+  namespace m = tensegrity_msgs::msg::dds_;
+  start_nodes(kDomain);
+  auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false);
+  ASSERT_TRUE(ground);
+  dds::DomainParticipant* impostor =
+      msgs::create_participant(kDomain, "impostor", nullptr, enclave("keystore", msgs::Role::endcap, 1));
+  struct Deleter {
+    dds::DomainParticipant* p;
+    ~Deleter() { msgs::delete_participant(p); }
+  } deleter{impostor};
+  dds::Publisher* own = impostor->create_publisher(msgs::endcap_publisher_qos(1));
+  dds::DataWriter* beats = msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic,
+                                               dds::TypeSupport(new m::Heartbeat_PubSubType()));
+  dds::DataWriter* acks =
+      msgs::create_writer(*impostor, *own, msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // matched in its own partition first
+  const auto moved = own->set_qos(msgs::endcap_publisher_qos(2));
+  std::printf("MEASURE set_qos to end cap 2's partition: return code %d\n", static_cast<int>(moved()));
+  m::Heartbeat_ hb;
+  hb.format_version(msgs::kFormatVersion);
+  hb.source(2);
+  hb.seq(4'000'000'000U);
+  m::CommandAck_ ack;
+  ack.format_version(msgs::kFormatVersion);
+  ack.endcap_id(2);
+  ack.seq(434343);
+  const std::uint64_t impostors_before = ground->impostor_samples();
+  for (int i = 0; i < 50; ++i) {
+    hb.seq(hb.seq() + 1);
+    beats->write(&hb);
+    acks->write(&ack);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  std::printf("MEASURE after the move: %llu samples refused as an impostor's\n",
+              static_cast<unsigned long long>(ground->impostor_samples() - impostors_before));
+  for (const auto& a : ground->take_command_acks()) EXPECT_NE(a.seq(), 434343U) << "a forged ack was taken";
+  EXPECT_LT(ground->snapshot()[2].heartbeat.seq(), 4'000'000'000U)
+      << "end cap 2's status shows the impostor's heartbeat";
 }
 
 // A lost board keeps a certificate the CA signed; `security revoke` puts it on the
