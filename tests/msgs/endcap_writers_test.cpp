@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// End cap partition names, both ways. The binding of samples to their writers'
-// partitions is tested over DDS (tests/ground/security_dds_test.cpp, the view's test).
+// End cap partition names, both ways, and a writer that changes partition. The
+// binding of samples to their writers' partitions is tested over DDS too
+// (tests/ground/security_dds_test.cpp, the view's test).
 #include "msgs/endcap_writers.hpp"
 
 #include <gtest/gtest.h>
@@ -39,6 +40,38 @@ TEST(EndcapWriters, AnUnknownWriterVouchesForNobody) {
   EXPECT_EQ(writers.endcap_of(info), -1);
   EXPECT_FALSE(writers.vouches(info, 0));
   EXPECT_FALSE(writers.vouches(info, -1));
+}
+
+// A writer discovered in end cap 1's partition that later announces end cap 2's
+// (a QoS update; docs/security.md "A writer that moves") vouches for nobody again.
+TEST(EndcapWriters, AWriterThatChangesPartitionVouchesForNobodyFromThenOn) {
+  namespace rtps = eprosima::fastrtps::rtps;
+  EndcapWriters writers;
+  rtps::WriterProxyData data(4, 4);
+  rtps::GUID_t guid;
+  guid.guidPrefix.value[0] = 7;
+  guid.entityId.value[3] = 3;
+  data.guid(guid);
+  auto announce = [&](const char* partition, rtps::WriterDiscoveryInfo::DISCOVERY_STATUS status) {
+    data.m_qos.m_partition.clear();
+    data.m_qos.m_partition.push_back(partition);
+    rtps::WriterDiscoveryInfo info(data);
+    info.status = status;
+    writers.on_publisher_discovery(nullptr, std::move(info));
+  };
+  eprosima::fastdds::dds::SampleInfo sample;
+  sample.sample_identity.writer_guid(guid);
+  announce("endcap_01", rtps::WriterDiscoveryInfo::DISCOVERED_WRITER);
+  EXPECT_TRUE(writers.vouches(sample, 1));
+  announce("endcap_01", rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER);  // same partition: still end cap 1
+  EXPECT_TRUE(writers.vouches(sample, 1));
+  announce("endcap_02", rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER);
+  EXPECT_FALSE(writers.vouches(sample, 2));
+  EXPECT_FALSE(writers.vouches(sample, 1));
+  announce("endcap_01", rtps::WriterDiscoveryInfo::CHANGED_QOS_WRITER);  // moving back does not help
+  EXPECT_FALSE(writers.vouches(sample, 1));
+  announce("endcap_01", rtps::WriterDiscoveryInfo::REMOVED_WRITER);
+  EXPECT_EQ(writers.endcap_of(sample), -1);
 }
 
 }  // namespace
