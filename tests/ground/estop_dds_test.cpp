@@ -155,16 +155,26 @@ TEST_F(Estop, LandsUnderAForgedClock) {
   start_nodes(kDomain, {"--quiet"});
   Station& s = station(kDomain);
   ASSERT_TRUE(s.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));
-  std::this_thread::sleep_for(std::chrono::seconds(1));  // a burst of time syncs, each answered twice
-  ASSERT_GT(rogue.answered(), 12U) << "the rogue answered no time-sync request";
-  for (const auto& e : s.snapshot()) {
-    // Never the rogue's hour once the host answers too: with two disagreeing
-    // answers to each request the end cap believes neither (the rogue spoke first,
-    // before this host existed).
-    if (e.heartbeat.clock_synced()) {
-      EXPECT_LT(std::llabs(e.heartbeat.clock_offset_ns()), seconds(60));
+  // Never the rogue's hour once the host answers too: with two disagreeing answers
+  // to a request the end cap believes neither and drops what it had. The rogue
+  // spoke first, before this host existed, so an end cap may have taken its hour
+  // then; on a loaded machine the host's first answers can come a second or more
+  // later. Bounded: every end cap has given the rogue's hour up within 10 s.
+  const std::int64_t hosts_answers = Station::now_ns();
+  auto keeps_rogue_hour = [&] {
+    int keeping = 0;
+    for (const auto& e : s.snapshot()) {
+      keeping += e.heartbeat.clock_synced() && std::llabs(e.heartbeat.clock_offset_ns()) >= seconds(60) ? 1 : 0;
     }
+    return keeping;
+  };
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // a burst of time syncs, each answered twice
+  while (keeps_rogue_hour() > 0 && Station::now_ns() - hosts_answers < seconds(10)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
+  ASSERT_GT(rogue.answered(), 12U) << "the rogue answered no time-sync request";
+  EXPECT_EQ(keeps_rogue_hour(), 0) << "end caps still on the rogue's hour 10 s after the host answers too";
+  std::printf("MEASURE forged_clock rogue_hour_given_up_after_ms=%.0f\n", ms(Station::now_ns() - hosts_answers));
   const std::int64_t sent = Station::now_ns();
   const CommandReport estop = command(CommandKind::emergency_stop);
   ASSERT_TRUE(estop.all_accepted()) << format_command_report(estop);
