@@ -89,8 +89,25 @@ class ConsoleLink : public ::testing::Test {
     fs::create_directories(dir_);
     fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::replace);  // a console's folder is private
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override {
+    nodes_.reset();
+    fs::remove_all(dir_);
+  }
+  // End caps 0-2 (comms_test_node) on `domain`, and a station that hears them; null
+  // when either does not come up within 20 s.
+  std::shared_ptr<Station> three_endcaps(int domain) {
+    nodes_ = std::make_unique<Subprocess>(
+        std::vector<std::string>{COMMS_TEST_NODE, "--domain", std::to_string(domain), "--endcaps", "0-2"},
+        dir_ / "nodes.out", dir_ / "nodes.err");
+    if (!nodes_->wait_for_output("READY", std::chrono::seconds(20))) return nullptr;
+    StationOptions o;
+    o.domain = domain;
+    auto station = std::make_shared<Station>(o);
+    if (!station->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000)) return nullptr;
+    return station;
+  }
   fs::path dir_;
+  std::unique_ptr<Subprocess> nodes_;
 };
 
 TEST_F(ConsoleLink, OneListenerPerSocketAndADeadOnesSocketIsReplaced) {
@@ -140,14 +157,8 @@ TEST_F(ConsoleLink, TheServerMakesItsFolderPrivateAndRefusesABadRequestByName) {
 // End caps 0-2 answer; a stop addressed to 0-3 waits for end cap 3 until its
 // deadline, unless an emergency stop takes over: the estop then lands at once.
 TEST_F(ConsoleLink, AnEstopPreemptsAStopInFlight) {
-  constexpr int kDomain = 180;
-  Subprocess nodes({COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", "0-2"}, dir_ / "nodes.out",
-                   dir_ / "nodes.err");
-  ASSERT_TRUE(nodes.wait_for_output("READY", std::chrono::seconds(20)));
-  StationOptions o;
-  o.domain = kDomain;
-  auto station = std::make_shared<Station>(o);
-  ASSERT_TRUE(station->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000));
+  const std::shared_ptr<Station> station = three_endcaps(180);
+  ASSERT_TRUE(station) << "end caps 0-2 or the station did not come up";
   OperatorServer server([station] { return station; }, dir_ / "c.sock");
 
   const std::int64_t t0 = Station::now_ns();
@@ -183,14 +194,8 @@ TEST_F(ConsoleLink, AnEstopPreemptsAStopInFlight) {
 // An estop for end cap 3 (absent) is preempted by a newer estop for end cap 0: the
 // newer one takes end cap 3 over, so no end cap an estop was meant for is dropped.
 TEST_F(ConsoleLink, ANewerEstopTakesOverTheEndcapsAnOlderOneMissed) {
-  constexpr int kDomain = 186;
-  Subprocess nodes({COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", "0-2"}, dir_ / "nodes.out",
-                   dir_ / "nodes.err");
-  ASSERT_TRUE(nodes.wait_for_output("READY", std::chrono::seconds(20)));
-  StationOptions o;
-  o.domain = kDomain;
-  auto station = std::make_shared<Station>(o);
-  ASSERT_TRUE(station->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000));
+  const std::shared_ptr<Station> station = three_endcaps(186);
+  ASSERT_TRUE(station) << "end caps 0-2 or the station did not come up";
   OperatorServer server([station] { return station; }, dir_ / "c.sock");
   auto older = std::async(std::launch::async, [&] { return server.run({CommandKind::emergency_stop, 0b1000, 20.0}); });
   std::this_thread::sleep_for(std::chrono::milliseconds(300));

@@ -182,6 +182,29 @@ TEST_F(SecureDds, AnEndcapIdentityCannotGiveOrders) {
   EXPECT_THROW(station(kDomain, enclave("keystore", msgs::Role::listener)), msgs::DdsError);
 }
 
+// What a stolen board could run: a participant with end cap 1's identity and its
+// heartbeat and command-ack writers in end cap 1's own partition.
+struct EndcapOneImpostor {
+  explicit EndcapOneImpostor(int domain, const fs::path& enclave_dir)
+      : participant(msgs::create_participant(domain, "impostor", nullptr, enclave_dir)) {}
+  ~EndcapOneImpostor() { msgs::delete_participant(participant); }
+  EndcapOneImpostor(const EndcapOneImpostor&) = delete;
+  EndcapOneImpostor& operator=(const EndcapOneImpostor&) = delete;
+  void make_writers() {
+    namespace dds = eprosima::fastdds::dds;
+    namespace m = tensegrity_msgs::msg::dds_;
+    publisher = participant->create_publisher(msgs::endcap_publisher_qos(1));
+    beats = msgs::create_writer(*participant, *publisher, msgs::kEndcapHeartbeatTopic,
+                                dds::TypeSupport(new m::Heartbeat_PubSubType()));
+    acks = msgs::create_writer(*participant, *publisher, msgs::kCommandAckTopic,
+                               dds::TypeSupport(new m::CommandAck_PubSubType()));
+  }
+  eprosima::fastdds::dds::DomainParticipant* participant;
+  eprosima::fastdds::dds::Publisher* publisher = nullptr;
+  eprosima::fastdds::dds::DataWriter* beats = nullptr;
+  eprosima::fastdds::dds::DataWriter* acks = nullptr;
+};
+
 // End cap 1's identity writes its reports only in end cap 1's partition (Fast DDS
 // refuses a writer anywhere else), and the ground refuses what it sends from there
 // under end cap 2's name: one end cap cannot ack, report or beat for another.
@@ -192,25 +215,18 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
   start_nodes(kDomain);
   auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false);
   ASSERT_TRUE(ground);
-  dds::DomainParticipant* impostor =
-      msgs::create_participant(kDomain, "impostor", nullptr, enclave("keystore", msgs::Role::endcap, 1));
-  struct Deleter {
-    dds::DomainParticipant* p;
-    ~Deleter() { msgs::delete_participant(p); }
-  } deleter{impostor};
+  EndcapOneImpostor impostor(kDomain, enclave("keystore", msgs::Role::endcap, 1));
   for (const dds::PublisherQos& elsewhere : {msgs::endcap_publisher_qos(2), dds::PUBLISHER_QOS_DEFAULT}) {
-    dds::Publisher* pub = impostor->create_publisher(elsewhere);
+    dds::Publisher* pub = impostor.participant->create_publisher(elsewhere);
     ASSERT_NE(pub, nullptr);
-    EXPECT_THROW(msgs::create_writer(*impostor, *pub, msgs::kEndcapHeartbeatTopic,
+    EXPECT_THROW(msgs::create_writer(*impostor.participant, *pub, msgs::kEndcapHeartbeatTopic,
                                      dds::TypeSupport(new m::Heartbeat_PubSubType())),
                  msgs::DdsError)
         << "a writer outside end cap 1's partition";
   }
-  dds::Publisher* own = impostor->create_publisher(msgs::endcap_publisher_qos(1));
-  dds::DataWriter* beats = msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic,
-                                               dds::TypeSupport(new m::Heartbeat_PubSubType()));
-  dds::DataWriter* acks =
-      msgs::create_writer(*impostor, *own, msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
+  impostor.make_writers();
+  dds::DataWriter* beats = impostor.beats;
+  dds::DataWriter* acks = impostor.acks;
   m::Heartbeat_ hb;
   hb.format_version(msgs::kFormatVersion);
   hb.source(2);
@@ -242,19 +258,12 @@ TEST_F(SecureDds, AnEndcapIdentityCannotMoveItsWritersIntoAnotherPartition) {
   start_nodes(kDomain);
   auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false);
   ASSERT_TRUE(ground);
-  dds::DomainParticipant* impostor =
-      msgs::create_participant(kDomain, "impostor", nullptr, enclave("keystore", msgs::Role::endcap, 1));
-  struct Deleter {
-    dds::DomainParticipant* p;
-    ~Deleter() { msgs::delete_participant(p); }
-  } deleter{impostor};
-  dds::Publisher* own = impostor->create_publisher(msgs::endcap_publisher_qos(1));
-  dds::DataWriter* beats = msgs::create_writer(*impostor, *own, msgs::kEndcapHeartbeatTopic,
-                                               dds::TypeSupport(new m::Heartbeat_PubSubType()));
-  dds::DataWriter* acks =
-      msgs::create_writer(*impostor, *own, msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
+  EndcapOneImpostor impostor(kDomain, enclave("keystore", msgs::Role::endcap, 1));
+  impostor.make_writers();
+  dds::DataWriter* beats = impostor.beats;
+  dds::DataWriter* acks = impostor.acks;
   std::this_thread::sleep_for(std::chrono::seconds(2));  // matched in its own partition first
-  const auto moved = own->set_qos(msgs::endcap_publisher_qos(2));
+  const auto moved = impostor.publisher->set_qos(msgs::endcap_publisher_qos(2));
   std::printf("MEASURE set_qos to end cap 2's partition: return code %d\n", static_cast<int>(moved()));
   m::Heartbeat_ hb;
   hb.format_version(msgs::kFormatVersion);
