@@ -6,8 +6,8 @@
 // ground tools on this machine through a local socket (ground/operator_server.hpp):
 // with a console running, `tensegrity estop` lands in milliseconds instead of after
 // a fresh participant's seconds of security handshakes.
-#include <bit>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -78,10 +78,10 @@ class KeyCommands {
   std::vector<Worker> workers_;  // touched by the key loop only
 };
 
-void show(const ground::Station& station, std::uint16_t expected, bool terminal, const std::string& header,
-          const std::string& last) {
+// A terminal's live table, redrawn as `status` draws it.
+void show(const ground::Station& station, std::uint16_t expected, const std::string& header, const std::string& last) {
   const std::int64_t now = ground::Station::now_ns();
-  if (terminal) std::fputs("\033[H\033[2J", stdout);  // a live table, as `status` draws it
+  std::fputs("\033[H\033[2J", stdout);
   std::fputs(header.c_str(), stdout);
   std::fputs(ground::format_status_table(station.snapshot(), now, expected).c_str(), stdout);
   std::fputs(last.c_str(), stdout);
@@ -133,7 +133,7 @@ void run_console(const ConsoleArgs& args) {
       if (std::chrono::steady_clock::now() < next_draw && reports == shown_reports) continue;
       next_draw = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                          std::chrono::duration<double>(args.period_s));
-      show(*keeper.current(), expected, true, header, last);
+      show(*keeper.current(), expected, header, last);
       shown_reports = reports;
       continue;
     }
