@@ -74,6 +74,9 @@ def write_robot(args, out):
         set_field(doc, path, value)
     robot = out / "robot.json"
     text = json.dumps(doc, indent=2) + "\n"
+    if robot.exists() and robot.read_text() != text and any(out.glob("runs/s*/ckpt")):
+        sys.exit(f"{robot}: this arm's seeds learned on another robot; give the same --robot and --set "
+                 f"to resume it, or a new --out")
     if not robot.exists() or robot.read_text() != text:
         robot.write_text(text)
     return robot
@@ -182,8 +185,19 @@ def summarise_arm(out, args):
                                           "first_episode_28m", "first_episode_32m", "infeasible_first10"])
         w.writeheader()
         w.writerows(rows)
-    plot_arm(out, curves)
+    if have_matplotlib():
+        plot_arm(out, curves)
     return result
+
+
+def have_matplotlib():
+    # The numbers are the result; a machine without matplotlib still gets them.
+    try:
+        import matplotlib  # noqa: F401
+        return True
+    except ImportError:
+        print("arm.py: matplotlib not found, PNG plots skipped (the CSV and JSON are written)", file=sys.stderr)
+        return False
 
 
 def plot_arm(out, curves):
@@ -231,7 +245,8 @@ def compare(args):
               f"[{r['q1_m']:6.2f}, {r['q3_m']:6.2f}]  >=28: {r['seeds_ge_28']}  >=32: {r['seeds_ge_32']}  "
               f"first28: {r['first_episode_28m']} (median {r['first_episode_28m_median'] or '>' + str(r['budget'])})  "
               f"first32: {r['first_episode_32m']}  gen mean {r['generation_mean_median_m']:.2f}")
-    plot_compare(out, arms)
+    if have_matplotlib():
+        plot_compare(out, arms)
 
 
 def plot_compare(out, arms):
@@ -264,8 +279,10 @@ def main():
         return
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    robot = write_robot(args, out)
+    # A summary only reads: writing --robot's default into the arm would replace the
+    # record of the robot its seeds learned on (it did, in session 17).
     if not args.summary_only:
+        robot = write_robot(args, out)
         seeds = range(args.first_seed, args.first_seed + args.seeds)
         (out / "command.txt").write_text(" ".join([sys.argv[0]] + sys.argv[1:]) + "\n")
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
