@@ -58,9 +58,19 @@ def named(items, what):
     return out
 
 
+def read_json(path, what):
+    try:
+        return json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        sys.exit(f"--{what} {path}: {e}")
+
+
 def limits(robot_path):
-    cable = json.loads(robot_path.read_text())["cable"]
-    return cable["min_rest_length_m"], cable["max_rest_length_m"]
+    try:
+        cable = read_json(robot_path, "robot")["cable"]
+        return float(cable["min_rest_length_m"]), float(cable["max_rest_length_m"])
+    except (KeyError, TypeError, ValueError) as e:
+        sys.exit(f"--robot {robot_path}: cable.min_rest_length_m / cable.max_rest_length_m: {e}")
 
 
 def tables_for(gait_doc, rng, args, lo, hi):
@@ -88,6 +98,13 @@ def play(args, doc, robot, path):
 def main():
     args = parse_args()
     args.sigma = args.sigma or [0.01, 0.02, 0.05]
+    for name, value in (("--random", args.random), ("--copies", args.copies), ("--jobs", args.jobs)):
+        if value < 0 or (name == "--jobs" and value < 1):
+            sys.exit(f"{name} {value}: must be {'at least 1' if name == '--jobs' else 'zero or more'}")
+    if args.steps < 1:
+        sys.exit(f"--steps {args.steps}: must be at least 1")
+    if any(not 0 <= sigma <= 1 for sigma in args.sigma):
+        sys.exit(f"--sigma {args.sigma}: each must lie in [0, 1] m")
     gaits, robots = named(args.gait, "gait"), named(args.robot, "robot")
     lo, hi = limits(next(iter(robots.values())))
     out = pathlib.Path(args.out)
@@ -95,7 +112,11 @@ def main():
     rng = random.Random(args.seed)
     jobs = []
     for gname, gpath in gaits.items():
-        gait = json.loads(gpath.read_text())
+        gait = read_json(gpath, "gait")
+        cables = gait.get("cables") if isinstance(gait, dict) else None
+        if not isinstance(cables, list) or not all(isinstance(c, dict) and isinstance(c.get("rest_lengths_m"), list)
+                                                   for c in cables):
+            sys.exit(f"--gait {gpath}: not a policy file (cables[].rest_lengths_m missing)")
         for probe, k, x, values in tables_for(gait, rng, args, lo, hi):
             doc = copy.deepcopy(gait)
             doc["provenance"] = {"created_by": f"tools/needle_probe.py: {probe} {k} at {x} around {gpath}"}
