@@ -154,7 +154,10 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--tensegrity", help="the tensegrity program (default: build/release or build/default)")
-    p.add_argument("--policy", help="policy file (default: the HIL's, policies/superball-ntrt2014-t4-n5.json)")
+    # The paper's Figure 13 is about the paper's robot, so the default is the 2014 file's
+    # gait (docs/hil.md's figure), not whatever the HIL plays by default.
+    p.add_argument("--policy", default=os.path.join(ROOT, "policies", "superball-ntrt2014-t4-n5.json"),
+                   help="policy file (default: policies/superball-ntrt2014-t4-n5.json, the paper's robot)")
     p.add_argument("--robot", default=os.path.join(ROOT, "robots", "superball-ntrt2014.json"), help="robot file (cable owners; the policy's)")
     p.add_argument("--duration", type=float, default=60.0, help="seconds of physics per run (paper: 60)")
     p.add_argument("--mode", choices=["lockstep", "realtime"], default="lockstep")
@@ -192,7 +195,7 @@ def main():
             print(f"  {failure}: cable {m:2d} (end cap {owner[m]:2d}): {r['distance_m']:7.3f} m ({pct:+6.1f} %, "
                   f"{r['wall_s']:.1f} s wall)", flush=True)
     meta = {"duration_s": args.duration, "mode": args.mode, "provision": args.provision,
-            "provisioner": base["provisioner"], "policy": args.policy or "policies/superball-ntrt2014-t4-n5.json"}
+            "provisioner": base["provisioner"], "policy": os.path.relpath(args.policy, ROOT)}
     print(write_outputs(args.out, rows, meta))
     print(plot(args.out, rows, title))
     for failure in failures:

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: Apache-2.0
+// The policies in policies/ are results: each must still roll what it was scored
+// with, so that a change to the model, the control core or the policy format that
+// moves a shipped gait is seen here and not in a user's run.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "sim/core_controller.hpp"
+#include "sim/episode.hpp"
+#include "sim/policy.hpp"
+
+namespace tensegrity::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path policies_dir() { return default_robot_path().parent_path().parent_path() / "policies"; }
+
+EpisodeResult play(const Robot& robot, const Policy& policy) {
+  CoreController controller(robot, policy);
+  EpisodeOptions options;  // 60 s from the robot's own start, at its own step: as scored
+  return run_episode(robot, controller, options);
+}
+
+TEST(ShippedPolicies, EachRollsTheDistanceItWasScoredWith) {
+  int checked = 0;
+  for (const auto& entry : fs::directory_iterator(policies_dir())) {
+    if (entry.path().extension() != ".json") continue;
+    const Robot robot = load_robot(robot_path_for_policy(entry.path()));
+    const Policy policy = load_policy(entry.path(), robot);
+    const EpisodeResult r = play(robot, policy);
+    EXPECT_TRUE(r.feasible) << entry.path() << ": " << r.infeasible_reason;
+    EXPECT_NEAR(r.distance_m, policy.provenance.score_m, 1e-6 * policy.provenance.score_m) << entry.path();
+    ++checked;
+  }
+  EXPECT_GE(checked, 2);
+}
+
+// The main job's gait (scripts/run.sh, `tensegrity hil` by default) is held to what
+// issue 14 asks of a shipped policy: learned from scratch within the paper's 5000
+// episodes, at least the paper's 32 m, rolling on all 12 end caps with no strut
+// spinning about its own axis, and clear of the firmware's tension cut-off.
+TEST(ShippedPolicies, TheMainJobsGaitRollsAsTheIssueAsks) {
+  const fs::path file = policies_dir() / "superball-spin-held-t4-n5.json";
+  const Robot robot = load_robot(robot_path_for_policy(file));
+  const Policy policy = load_policy(file, robot);
+  EXPECT_EQ(policy.provenance.method, "historical");
+  EXPECT_LE(policy.provenance.episodes, 5000);
+  EXPECT_GE(policy.provenance.score_m, 32.0);
+
+  const EpisodeResult r = play(robot, policy);
+  EXPECT_GE(r.distance_m, 32.0);
+  EXPECT_EQ(r.endcaps_touched_ground, 12);
+  EXPECT_LT(r.axial_spin_max_rad_per_s, 1e-6);
+  // A gait at the cut-off would be cut by any model error on the robot; this one keeps
+  // a tenth of it in hand.
+  EXPECT_LT(r.max_tension_n, 0.9 * robot.motor.cutoff_tension_n);
+}
+
+}  // namespace
+}  // namespace tensegrity::sim
