@@ -16,13 +16,15 @@ duration=60
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --evolve) evolve=1 ;;
-    --duration) duration="$2"; shift ;;
-    --seed) seed="$2"; shift ;;
+    --duration) duration="${2:?run: --duration needs seconds}"; shift ;;
+    --seed) seed="${2:?run: --seed needs a number}"; shift ;;
     -h|--help) sed -n '3,10p' "$0"; exit 0 ;;
     *) echo "run: unknown argument $1 (try --help)" >&2; exit 2 ;;
   esac
   shift
 done
+# Checked before the build, not after minutes of it.
+[[ $seed =~ ^[0-9]+$ ]] || { echo "run: --seed must be a whole number, not '$seed'" >&2; exit 2; }
 
 scripts/setup.sh
 cmake --preset release >/dev/null
