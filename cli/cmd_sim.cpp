@@ -4,6 +4,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 
 #include "cli/commands.hpp"
 #include "cli/episode_json.hpp"
@@ -25,6 +26,17 @@ struct SimArgs {
   bool start_given = false;
   bool json = false;
 };
+
+// The drop start lets the description's pose fall; the settled start lets the pose the
+// robot file chose fall and scores from where it lies, so the pose is named.
+std::string start_text(const sim::Robot& robot, sim::StartKind kind) {
+  if (kind == sim::StartKind::drop) return "drop start from the description's pose";
+  const char* pose =
+      robot.start_pose == sim::Robot::StartPose::face_down ? "a cable triangle face down" : "the description's pose";
+  char text[128];
+  std::snprintf(text, sizeof text, "settled start (%s, %.3g s)", pose, robot.settle_s);
+  return text;
+}
 
 void run_sim(const SimArgs& args) {
   const sim::Robot robot = load_robot_arg(args.robot, args.policy);
@@ -58,9 +70,9 @@ void run_sim(const SimArgs& args) {
     j["dt_s"] = options.dt_s > 0 ? options.dt_s : robot.time_step_s;
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("robot %s (%s), %s, %.1f s at dt %.4g s, %s start\n", robot.name.c_str(), robot.hash.c_str(),
+    std::printf("robot %s (%s), %s, %.1f s at dt %.4g s, %s\n", robot.name.c_str(), robot.hash.c_str(),
                 controller_name.c_str(), args.duration_s, options.dt_s > 0 ? options.dt_s : robot.time_step_s,
-                options.start == sim::StartKind::drop ? "drop" : "settled");
+                start_text(robot, options.start).c_str());
     print_episode_summary(result);
   }
 }

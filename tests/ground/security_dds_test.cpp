@@ -199,8 +199,24 @@ struct EndcapOneImpostor {
     acks = msgs::create_writer(*participant, *publisher, msgs::kCommandAckTopic,
                                dds::TypeSupport(new m::CommandAck_PubSubType()));
   }
+  // One heartbeat and one ack under end cap 2's name; the heartbeat's seq starts far
+  // from any seq end cap 2 reaches in a test and moves on each send.
+  void send_as_endcap_two(std::uint32_t ack_seq) {
+    namespace m = tensegrity_msgs::msg::dds_;
+    m::Heartbeat_ hb;
+    hb.format_version(msgs::kFormatVersion);
+    hb.source(2);
+    hb.seq(++forged_seq);
+    m::CommandAck_ ack;
+    ack.format_version(msgs::kFormatVersion);
+    ack.endcap_id(2);
+    ack.seq(ack_seq);
+    beats->write(&hb);
+    acks->write(&ack);
+  }
   eprosima::fastdds::dds::DomainParticipant* participant;
   eprosima::fastdds::dds::Publisher* publisher = nullptr;
+  std::uint32_t forged_seq = 4'000'000'000U;
   eprosima::fastdds::dds::DataWriter* beats = nullptr;
   eprosima::fastdds::dds::DataWriter* acks = nullptr;
 };
@@ -225,26 +241,15 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
         << "a writer outside end cap 1's partition";
   }
   impostor.make_writers();
-  dds::DataWriter* beats = impostor.beats;
-  dds::DataWriter* acks = impostor.acks;
-  m::Heartbeat_ hb;
-  hb.format_version(msgs::kFormatVersion);
-  hb.source(2);
-  hb.seq(4'000'000'000U);  // far from any seq end cap 2 reaches in a test
-  m::CommandAck_ ack;
-  ack.format_version(msgs::kFormatVersion);
-  ack.endcap_id(2);
-  ack.seq(424242);
   const std::int64_t deadline = after_s(20);
   while (ground->impostor_samples() < 2 && Station::now_ns() < deadline) {
-    hb.seq(hb.seq() + 1);
-    beats->write(&hb);
-    acks->write(&ack);
+    impostor.send_as_endcap_two(424242);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   EXPECT_GE(ground->impostor_samples(), 2U) << "the impostor's samples never reached the ground";
   for (const auto& a : ground->take_command_acks()) EXPECT_NE(a.seq(), 424242U) << "a forged ack was taken";
-  EXPECT_NE(ground->snapshot()[2].heartbeat.seq(), hb.seq()) << "end cap 2's status shows the impostor's heartbeat";
+  EXPECT_NE(ground->snapshot()[2].heartbeat.seq(), impostor.forged_seq)
+      << "end cap 2's status shows the impostor's heartbeat";
 }
 
 // Partition is a mutable QoS: an end cap's identity that made its writers in its own
@@ -253,31 +258,17 @@ TEST_F(SecureDds, AnEndcapIdentitySpeaksOnlyForItself) {
 // sends under end cap 2's id must still never count as end cap 2's.
 TEST_F(SecureDds, AnEndcapIdentityCannotMoveItsWritersIntoAnotherPartition) {
   constexpr int kDomain = 187;
-  namespace dds = eprosima::fastdds::dds;
-  namespace m = tensegrity_msgs::msg::dds_;
   start_nodes(kDomain);
   auto ground = joined(kDomain, enclave("keystore", msgs::Role::ground), kThree, false);
   ASSERT_TRUE(ground);
   EndcapOneImpostor impostor(kDomain, enclave("keystore", msgs::Role::endcap, 1));
   impostor.make_writers();
-  dds::DataWriter* beats = impostor.beats;
-  dds::DataWriter* acks = impostor.acks;
   std::this_thread::sleep_for(std::chrono::seconds(2));  // matched in its own partition first
   const auto moved = impostor.publisher->set_qos(msgs::endcap_publisher_qos(2));
   std::printf("MEASURE set_qos to end cap 2's partition: return code %d\n", static_cast<int>(moved()));
-  m::Heartbeat_ hb;
-  hb.format_version(msgs::kFormatVersion);
-  hb.source(2);
-  hb.seq(4'000'000'000U);
-  m::CommandAck_ ack;
-  ack.format_version(msgs::kFormatVersion);
-  ack.endcap_id(2);
-  ack.seq(434343);
   const std::uint64_t impostors_before = ground->impostor_samples();
   for (int i = 0; i < 50; ++i) {
-    hb.seq(hb.seq() + 1);
-    beats->write(&hb);
-    acks->write(&ack);
+    impostor.send_as_endcap_two(434343);
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   std::printf("MEASURE after the move: %llu samples refused as an impostor's\n",
