@@ -20,6 +20,10 @@ Examples:
   tools/arm.py --out out/arms/gauss-d005 --robot robots/superball-ntrt2014.json \\
       --set time_step_s=0.002 --seeds 10 --episodes 1000 -- --mutation gaussian
   tools/arm.py --compare out/arms/A out/arms/B --out out/arms/compare --at 1000
+
+With --compare the first arm is the control: every other arm is tested against it
+at each budget both reached (tools/arm_stats.py: Mann-Whitney on the bests, Fisher
+on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m).
 """
 import argparse
 import concurrent.futures
@@ -30,6 +34,8 @@ import pathlib
 import statistics
 import subprocess
 import sys
+
+import arm_stats
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 TARGET_M = 32.0
@@ -52,7 +58,8 @@ def parse_args():
     p.add_argument("--at", type=int, action="append", default=None,
                    help="budgets to summarise at (default: 1000, 2500, 5000 up to --episodes)")
     p.add_argument("--summary-only", action="store_true", help="summarise the runs there, run nothing")
-    p.add_argument("--compare", nargs="+", metavar="ARM_DIR", help="compare finished arms instead of running one")
+    p.add_argument("--compare", nargs="+", metavar="ARM_DIR",
+                   help="compare finished arms instead of running one; the first is the control")
     p.add_argument("evolve_args", nargs="*", help="more `tensegrity evolve` options (after --)")
     return p.parse_args()
 
@@ -164,7 +171,7 @@ def budgets(args, episodes):
     return [b for b in (500, 1000, 2500, 5000) if b <= episodes] or [episodes]
 
 
-def summarise_arm(out, args):
+def summarise_arm(out, args, write=True):
     runs = sorted((out / "runs").glob("s*/curve.csv"), key=lambda p: int(p.parent.name[1:]))
     curves = {int(p.parent.name[1:]): read_curve(p) for p in runs}
     curves = {s: c for s, c in curves.items() if c}
@@ -179,6 +186,8 @@ def summarise_arm(out, args):
         result["at"].append(summarise_budget(per_seed, b) | {"per_seed": per_seed})
         for s, m in per_seed.items():
             rows.append({"budget": b, "seed": s} | m)
+    if not write:  # a comparison reads the arms and writes only its own files
+        return result
     (out / "arm.json").write_text(json.dumps(result, indent=2) + "\n")
     with open(out / "arm.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["budget", "seed", "episodes", "best_m", "generation_mean_m",
@@ -227,15 +236,22 @@ def compare(args):
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     dirs = [d for d in args.compare if (pathlib.Path(d) / "runs").is_dir()]
-    arms = [summarise_arm(pathlib.Path(d), args) | {"dir": d} for d in dirs]
+    arms = [summarise_arm(pathlib.Path(d), args, write=False) | {"dir": d} for d in dirs]
     rows = []
-    for arm in arms:
+    control = {at["budget"]: at for at in arms[0]["at"]} if arms else {}
+    if len(arms) > 1 and not arm_stats.have_scipy():
+        print("arm.py: scipy not found, p-values against the control skipped", file=sys.stderr)
+    for i, arm in enumerate(arms):
         for at in arm["at"]:
-            rows.append({k: v for k, v in at.items() if k != "per_seed"} | {"arm": arm["arm"]})
+            row = {k: v for k, v in at.items() if k != "per_seed"} | {"arm": arm["arm"]}
+            if i > 0 and at["budget"] in control and arm_stats.have_scipy():
+                row |= arm_stats.against_control(at, control[at["budget"]], NEAR_M)
+            rows.append(row)
     (out / "compare.json").write_text(json.dumps(rows, indent=2) + "\n")
     fields = ["arm", "budget", "seeds", "median_m", "q1_m", "q3_m", "mean_m", "min_m", "max_m", "seeds_ge_28",
               "seeds_ge_32", "first_episode_28m", "first_episode_28m_median", "first_episode_32m",
-              "first_episode_32m_median", "generation_mean_median_m", "infeasible_first10_mean"]
+              "first_episode_32m_median", "generation_mean_median_m", "infeasible_first10_mean",
+              "p_mann_whitney", "p_fisher_28", "p_logrank_32"]
     with open(out / "compare.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -244,7 +260,9 @@ def compare(args):
         print(f"{r['arm']:<28} {r['budget']:>5} ep  n={r['seeds']:<2} median {r['median_m']:6.2f} "
               f"[{r['q1_m']:6.2f}, {r['q3_m']:6.2f}]  >=28: {r['seeds_ge_28']}  >=32: {r['seeds_ge_32']}  "
               f"first28: {r['first_episode_28m']} (median {r['first_episode_28m_median'] or '>' + str(r['budget'])})  "
-              f"first32: {r['first_episode_32m']}  gen mean {r['generation_mean_median_m']:.2f}")
+              f"first32: {r['first_episode_32m']}  gen mean {r['generation_mean_median_m']:.2f}"
+              + (f"  vs {arms[0]['arm']}: p {r['p_mann_whitney']:.3f} (Mann-Whitney), {r['p_fisher_28']:.3f} "
+                 f"(Fisher >=28 m), {r['p_logrank_32']:.3f} (log-rank, first >=32 m)" if "p_mann_whitney" in r else ""))
     if have_matplotlib():
         plot_compare(out, arms)
 
