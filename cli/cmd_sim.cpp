@@ -28,7 +28,14 @@ struct SimArgs {
 };
 
 // The drop start lets the description's pose fall; the settled start lets the pose the
-// robot file chose fall and scores from where it lies, so the pose is named.
+// robot file chose fall and scores from where it lies, so the pose is named. The
+// names are the robot file's `start.pose` values.
+nlohmann::json start_json(const sim::Robot& robot, sim::StartKind kind) {
+  if (kind == sim::StartKind::drop) return {{"kind", "drop"}, {"pose", "description"}};
+  const bool face_down = robot.start_pose == sim::Robot::StartPose::face_down;
+  return {{"kind", "settled"}, {"pose", face_down ? "face_down" : "description"}, {"settle_s", robot.settle_s}};
+}
+
 std::string start_text(const sim::Robot& robot, sim::StartKind kind) {
   if (kind == sim::StartKind::drop) return "drop start from the description's pose";
   const char* pose =
@@ -67,6 +74,7 @@ void run_sim(const SimArgs& args) {
     j["robot"] = robot.name;
     j["robot_hash"] = robot.hash;
     j["controller"] = controller_name;
+    j["start"] = start_json(robot, options.start);
     j["dt_s"] = options.dt_s > 0 ? options.dt_s : robot.time_step_s;
     std::printf("%s\n", j.dump(2).c_str());
   } else {
