@@ -24,12 +24,15 @@ EpisodeResult play(const Robot& robot, const Policy& policy) {
   return run_episode(robot, controller, options);
 }
 
-TEST(ShippedPolicies, EachRollsTheDistanceItWasScoredWith) {
+TEST(ShippedPolicies, EachLoadsWithItsRobotAndRollsTheDistanceItWasScoredWith) {
   int checked = 0;
   for (const auto& entry : fs::directory_iterator(policies_dir())) {
     if (entry.path().extension() != ".json") continue;
     const Robot robot = load_robot(robot_path_for_policy(entry.path()));
     const Policy policy = load_policy(entry.path(), robot);
+    EXPECT_EQ(policy.provenance.robot_hash, robot.hash)
+        << entry.path() << ": made for another version of " << robot.name;
+    EXPECT_GT(policy.provenance.episodes, 0) << entry.path();
     const EpisodeResult r = play(robot, policy);
     EXPECT_TRUE(r.feasible) << entry.path() << ": " << r.infeasible_reason;
     EXPECT_NEAR(r.distance_m, policy.provenance.score_m, 1e-6 * policy.provenance.score_m) << entry.path();
