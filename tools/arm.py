@@ -235,7 +235,11 @@ def plot_arm(out, curves):
 def compare(args):
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    dirs = [d for d in args.compare if (pathlib.Path(d) / "runs").is_dir()]
+    # The first arm is the control: a mistyped one must not silently hand that role on.
+    missing = [d for d in args.compare if not (pathlib.Path(d) / "runs").is_dir()]
+    if missing:
+        sys.exit(f"arm.py: --compare: no runs/ in {', '.join(missing)}")
+    dirs = args.compare
     arms = [summarise_arm(pathlib.Path(d), args, write=False) | {"dir": d} for d in dirs]
     rows = []
     control = {at["budget"]: at for at in arms[0]["at"]} if arms else {}

@@ -89,6 +89,11 @@ class Compare(unittest.TestCase):
             self.assertIn("vs control", done.stdout)
             # Comparing reads the arms: their own summaries are not rewritten.
             self.assertFalse((control / "arm.json").exists())
+            # A control without runs is an error, not a quiet change of control.
+            typo = subprocess.run([sys.executable, str(TOOLS / "arm.py"), "--compare", str(root / "contrl"),
+                                   str(better), "--out", str(out)], capture_output=True, text=True)
+            self.assertNotEqual(typo.returncode, 0)
+            self.assertIn("contrl", typo.stderr)
 
 
 if __name__ == "__main__":
