@@ -23,7 +23,10 @@ Examples:
 
 With --compare the first arm is the control: every other arm is tested against it
 at each budget both reached (tools/arm_stats.py: Mann-Whitney on the bests, Fisher
-on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m).
+on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m). An arm is
+its directory, or the arm.csv it wrote (as kept in docs/results/arms/), so a
+recorded arm can be the control of one run on another machine:
+  tools/arm.py --compare docs/results/arms/ode-replica-5000.csv out/arms/pop40 --out C
 """
 import argparse
 import concurrent.futures
@@ -58,8 +61,9 @@ def parse_args():
     p.add_argument("--at", type=int, action="append", default=None,
                    help="budgets to summarise at (default: 1000, 2500, 5000 up to --episodes)")
     p.add_argument("--summary-only", action="store_true", help="summarise the runs there, run nothing")
-    p.add_argument("--compare", nargs="+", metavar="ARM_DIR",
-                   help="compare finished arms instead of running one; the first is the control")
+    p.add_argument("--compare", nargs="+", metavar="ARM",
+                   help="compare finished arms (directories, or their recorded arm.csv) instead of running "
+                        "one; the first is the control")
     p.add_argument("evolve_args", nargs="*", help="more `tensegrity evolve` options (after --)")
     return p.parse_args()
 
@@ -199,6 +203,30 @@ def summarise_arm(out, args, write=True):
     return result
 
 
+def read_recorded_arm(path, args):
+    """An arm as its arm.csv recorded it: the per-seed metrics at the budgets it kept
+    (those of --at only, when given). No curves, so no plot of its own."""
+    def episode(text):  # blank: no such team by that budget
+        return int(float(text)) if text else None
+    per_budget = {}
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            per_budget.setdefault(int(row["budget"]), {})[int(row["seed"])] = {
+                "best_m": float(row["best_m"]), "generation_mean_m": float(row["generation_mean_m"]),
+                "first_episode_32m": episode(row["first_episode_32m"]),
+                "first_episode_28m": episode(row["first_episode_28m"]),
+                "infeasible_first10": float(row["infeasible_first10"]), "episodes": int(row["episodes"])}
+    wanted = set(args.at) if args.at else set(per_budget)
+    return {"arm": path.stem, "command": f"recorded in {path}",
+            "at": [summarise_budget(per_seed, b) | {"per_seed": per_seed}
+                   for b, per_seed in sorted(per_budget.items()) if b in wanted]}
+
+
+def read_arm(path, args):
+    path = pathlib.Path(path)
+    return read_recorded_arm(path, args) if path.is_file() else summarise_arm(path, args, write=False)
+
+
 def have_matplotlib():
     # The numbers are the result; a machine without matplotlib still gets them.
     try:
@@ -236,11 +264,11 @@ def compare(args):
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     # The first arm is the control: a mistyped one must not silently hand that role on.
-    missing = [d for d in args.compare if not (pathlib.Path(d) / "runs").is_dir()]
+    missing = [d for d in args.compare
+               if not (pathlib.Path(d) / "runs").is_dir() and not pathlib.Path(d).is_file()]
     if missing:
-        sys.exit(f"arm.py: --compare: no runs/ in {', '.join(missing)}")
-    dirs = args.compare
-    arms = [summarise_arm(pathlib.Path(d), args, write=False) | {"dir": d} for d in dirs]
+        sys.exit(f"arm.py: --compare: neither an arm directory with runs/ nor an arm.csv: {', '.join(missing)}")
+    arms = [read_arm(d, args) | {"dir": d} for d in args.compare]
     rows = []
     control = {at["budget"]: at for at in arms[0]["at"]} if arms else {}
     if len(arms) > 1 and not arm_stats.have_scipy():

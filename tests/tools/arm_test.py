@@ -95,6 +95,31 @@ class Compare(unittest.TestCase):
             self.assertNotEqual(typo.returncode, 0)
             self.assertIn("contrl", typo.stderr)
 
+    def test_a_recorded_arm_csv_is_the_same_control_as_its_runs(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            root = pathlib.Path(tmp)
+            control = write_arm(root, "control", [(5.0 + 0.1 * s, 900 if s < 3 else None) for s in range(10)])
+            better = write_arm(root, "better", [(6.0, 500 + 50 * s) for s in range(10)])
+            arm = [sys.executable, str(TOOLS / "arm.py")]
+            subprocess.run(arm + ["--out", str(control), "--summary-only", "--at", "1000", "--at", "2000"],
+                           capture_output=True, check=True)
+            recorded = root / "control-2000.csv"
+            (control / "arm.csv").rename(recorded)
+
+            def p_values(control_arm, out):
+                subprocess.run(arm + ["--compare", str(control_arm), str(better), "--out", str(root / out),
+                                      "--at", "2000"], capture_output=True, check=True)
+                with open(root / out / "compare.csv") as f:
+                    rows = list(csv.DictReader(f))
+                self.assertEqual([r["budget"] for r in rows], ["2000", "2000"])  # only the budget asked for
+                return {k: v for k, v in rows[1].items() if k.startswith("p_")}
+
+            from_runs, from_csv = p_values(control, "cmp-runs"), p_values(recorded, "cmp-csv")
+            self.assertEqual(from_runs, from_csv)
+            # The recorded first episodes (900 in three seeds, blank in seven) are read back as such.
+            expected = arm_stats.logrank([500 + 50 * s for s in range(10)], [900] * 3 + [None] * 7)[3]
+            self.assertAlmostEqual(float(from_csv["p_logrank_32"]), expected, places=12)
+
 
 if __name__ == "__main__":
     unittest.main()
