@@ -36,6 +36,8 @@ import sys
 import threading
 import time
 
+import sweep_figure
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 # What the paper reports (Iscen et al., sections 5-6), for the plots and the page.
@@ -213,6 +215,11 @@ def finals(done, method, period, complexity, episodes):
             if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)]
 
 
+def seed_finals(done, method, period, complexity, episodes):
+    return {d["seed"]: d["summary"]["final_score_m"] for d in done.values()
+            if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)}
+
+
 def write_csv(path, header, rows):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
@@ -304,29 +311,13 @@ def report(a, runs):
             plt.close(fig)
 
     def sweep(name, fig_no, keys, label, paper):
-        rows, xs, ms, sds = [], [], [], []
-        for x, (period, n) in keys:
-            vals = finals(done, "historical", period, n, a.sweep_episodes)
-            m, sd = mean_sd(vals)
-            rows.append((f"{x:g}", f"{m:.4f}", f"{sd:.4f}", len(vals), paper.get(x, "")))
-            if vals:
-                xs.append(x), ms.append(m), sds.append(sd)
-        write_csv(out / f"fig{fig_no}_{name}.csv", [label, "best_m", "best_sd_m", "seeds", "paper_m"], rows)
-        summary[name] = {f"{r[0]}": {"best_m": float(r[1]), "best_sd_m": float(r[2]), "seeds": r[3]} for r in rows}
-        if plt and xs:
-            fig, ax = plt.subplots(figsize=(7, 4.5))
-            ax.errorbar(xs, ms, yerr=sds, fmt="o-", capsize=3, label=f"this model ({a.sweep_seeds} seeds, "
-                                                                       f"{a.sweep_episodes} episodes)")
-            if paper:
-                ax.plot(list(paper), list(paper.values()), "s:", color="grey", label="paper")
-            ax.set_xlabel(label.replace("_", " "))
-            ax.set_ylabel("distance in 60 s, m")
-            ax.set_title(f"Figure {fig_no}: {name} sweep")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=8)
-            fig.tight_layout()
-            fig.savefig(out / f"fig{fig_no}_{name}.png", dpi=110)
-            plt.close(fig)
+        points = [(x, sweep_figure.point(seed_finals(done, "historical", period, n, a.sweep_episodes)))
+                  for x, (period, n) in keys]
+        sweep_figure.write_csv(out / f"fig{fig_no}_{name}.csv", label, points, paper)
+        summary[name] = {f"{x:g}": {k: v for k, v in p.items() if k != "per_seed"} for x, p in points}
+        if plt:
+            sweep_figure.plot(plt, out / f"fig{fig_no}_{name}.png", f"Figure {fig_no}: {name}", label, points,
+                              paper, a.sweep_episodes)
 
     if 8 in a.figures:
         sweep("period", 8, [(t, (t, 5)) for t in a.periods], "period_s", PAPER_PERIOD_M)
@@ -338,12 +329,25 @@ def report(a, runs):
     print(json.dumps(summary, indent=2))
 
 
+def pin_robot(a):
+    """OUT/robot.json is the robot every run there learned on. A run is found again by
+    its parameters alone, so another robot's runs must not be taken for this one's."""
+    out = pathlib.Path(a.out)
+    pinned, text = out / "robot.json", pathlib.Path(a.robot).read_text()
+    if pinned.exists() and pinned.read_text() != text and any(out.glob("runs/*/summary.json")):
+        sys.exit(f"experiments: the runs in {out} learned on the robot in {pinned}, not on {a.robot}; "
+                 f"give that robot (--robot {pinned}) or a new --out")
+    if not pinned.exists() or pinned.read_text() != text:
+        pinned.write_text(text)
+
+
 def main():
     a = parse_args()
     pathlib.Path(a.out).mkdir(parents=True, exist_ok=True)
     runs = plan(a)
     failures = []
     if not a.plot_only:
+        pin_robot(a)
         if not os.access(a.tensegrity, os.X_OK):
             sys.exit(f"experiments: {a.tensegrity} is not an executable (build: cmake --preset release && "
                      f"cmake --build --preset release --target tensegrity)")
