@@ -300,10 +300,13 @@ def compare(args):
 
 
 def plot_compare(out, arms):
+    """Left: every seed's best at each arm's last budget. Right: each arm's median and
+    quartiles at every budget, with the seeds at 32 m or more written on the median."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(max(6, 1.3 * len(arms)), 4.5))
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(max(11, 1.3 * len(arms) + 6), 4.5),
+                                  gridspec_kw={"width_ratios": [max(1, len(arms)), 3]})
     data, labels = [], []
     for arm in arms:
         if arm["at"]:
@@ -317,6 +320,21 @@ def plot_compare(out, arms):
     ax.axhline(TARGET_M, color="r", ls="--", lw=1)
     ax.set_ylabel("best team, m in 60 s")
     ax.tick_params(axis="x", labelsize=7)
+    for i, arm in enumerate(arms):
+        at = arm["at"]
+        if not at:
+            continue
+        x = [a["budget"] for a in at]
+        ax2.fill_between(x, [a["q1_m"] for a in at], [a["q3_m"] for a in at], color=f"C{i}", alpha=0.15)
+        ax2.plot(x, [a["median_m"] for a in at], "o-", color=f"C{i}", ms=3, label=arm["arm"])
+        for a in at:
+            ax2.annotate(str(a["seeds_ge_32"]), (a["budget"], a["median_m"]), textcoords="offset points",
+                         xytext=(0, 5), ha="center", fontsize=7, color=f"C{i}")
+    ax2.axhline(TARGET_M, color="r", ls="--", lw=1)
+    ax2.set_xlabel("episodes")
+    ax2.set_ylabel("best so far: median and quartiles, m")
+    ax2.set_title("numbers: seeds at 32 m or more", fontsize=8)
+    ax2.legend(fontsize=7, loc="upper left")
     fig.tight_layout()
     fig.savefig(out / "compare.png", dpi=110)
     plt.close(fig)
