@@ -43,6 +43,9 @@ import arm_stats
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 TARGET_M = 32.0
 NEAR_M = 28.0
+# An arm's arm.csv: one row per seed and budget.
+RECORDED_COLUMNS = ["budget", "seed", "episodes", "best_m", "generation_mean_m", "first_episode_28m",
+                    "first_episode_32m", "infeasible_first10"]
 
 
 def parse_args():
@@ -194,13 +197,19 @@ def summarise_arm(out, args, write=True):
         return result
     (out / "arm.json").write_text(json.dumps(result, indent=2) + "\n")
     with open(out / "arm.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["budget", "seed", "episodes", "best_m", "generation_mean_m",
-                                          "first_episode_28m", "first_episode_32m", "infeasible_first10"])
+        w = csv.DictWriter(f, fieldnames=RECORDED_COLUMNS)
         w.writeheader()
         w.writerows(rows)
     if have_matplotlib():
         plot_arm(out, curves)
     return result
+
+
+def add_recorded_row(per_budget, row, episode):
+    per_budget.setdefault(int(row["budget"]), {})[int(row["seed"])] = {
+        "best_m": float(row["best_m"]), "generation_mean_m": float(row["generation_mean_m"]),
+        "first_episode_32m": episode(row["first_episode_32m"]), "first_episode_28m": episode(row["first_episode_28m"]),
+        "infeasible_first10": float(row["infeasible_first10"]), "episodes": int(row["episodes"])}
 
 
 def read_recorded_arm(path, args):
@@ -210,12 +219,15 @@ def read_recorded_arm(path, args):
         return int(float(text)) if text else None
     per_budget = {}
     with open(path) as f:
-        for row in csv.DictReader(f):
-            per_budget.setdefault(int(row["budget"]), {})[int(row["seed"])] = {
-                "best_m": float(row["best_m"]), "generation_mean_m": float(row["generation_mean_m"]),
-                "first_episode_32m": episode(row["first_episode_32m"]),
-                "first_episode_28m": episode(row["first_episode_28m"]),
-                "infeasible_first10": float(row["infeasible_first10"]), "episodes": int(row["episodes"])}
+        reader = csv.DictReader(f)
+        missing = [c for c in RECORDED_COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            sys.exit(f"arm.py: --compare: {path} is not an arm.csv: no column {', '.join(missing)}")
+        for n, row in enumerate(reader, start=2):
+            try:
+                add_recorded_row(per_budget, row, episode)
+            except ValueError as e:
+                sys.exit(f"arm.py: --compare: {path}, line {n}: {e}")
     wanted = set(args.at) if args.at else set(per_budget)
     return {"arm": path.stem, "command": f"recorded in {path}",
             "at": [summarise_budget(per_seed, b) | {"per_seed": per_seed}

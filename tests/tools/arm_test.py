@@ -119,6 +119,15 @@ class Compare(unittest.TestCase):
             # The recorded first episodes (900 in three seeds, blank in seven) are read back as such.
             expected = arm_stats.logrank([500 + 50 * s for s in range(10)], [900] * 3 + [None] * 7)[3]
             self.assertAlmostEqual(float(from_csv["p_logrank_32"]), expected, places=12)
+            # Another CSV, or a damaged row, is refused by name, not with a traceback.
+            (root / "other.csv").write_text("budget,seed,best_m\n1000,1,5.0\n")
+            (root / "bad.csv").write_text(recorded.read_text().replace("2000,1,", "2000,x,", 1))
+            for name, says in (("other.csv", "first_episode_32m"), ("bad.csv", "line")):
+                refused = subprocess.run(arm + ["--compare", str(root / name), str(better), "--out", str(root / "c")],
+                                         capture_output=True, text=True)
+                self.assertNotEqual(refused.returncode, 0)
+                self.assertIn(says, refused.stderr)
+                self.assertNotIn("Traceback", refused.stderr)
 
 
 if __name__ == "__main__":
