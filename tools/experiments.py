@@ -76,6 +76,8 @@ def parse_args():
     p.add_argument("--plot-only", action="store_true", help="do not run anything; plot what is there")
     a = p.parse_args()
     a.sweep_episodes = a.sweep_episodes or a.episodes
+    if not pathlib.Path(a.robot).is_file():
+        p.error(f"--robot {a.robot}: no such file")
     if (a.sigma_final is None) != (a.anneal_episodes == 0):
         p.error("--sigma-final and --anneal-episodes go together")
     # Runs with another mutation than the default get their own directories.

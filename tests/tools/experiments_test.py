@@ -76,6 +76,9 @@ class Sweep(unittest.TestCase):
             refused = self.run_sweep(root, other, check=False)
             self.assertNotEqual(refused.returncode, 0)
             self.assertIn("robot.json", refused.stderr)
+            missing = self.run_sweep(root, root / "nowhere.json", check=False)
+            self.assertNotEqual(missing.returncode, 0)
+            self.assertIn("nowhere.json: no such file", missing.stderr)
             # the same robot again reuses every finished run
             again = self.run_sweep(root, robot)
             self.assertEqual(again.stdout.count("done already"), 6)
