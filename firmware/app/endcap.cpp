@@ -192,10 +192,13 @@ void Endcap::housekeeping() {
   while (loop_->pop_event(event)) log_event(event);
   if (loop_->read_status(last_status_)) log_status(last_status_);
   // At once, then once a second: the counts as of the loop's last status line, the
-  // link's events as they are now.
+  // link's events as they are now. A link event is written within this pass, not up
+  // to a second later: a program killed soon after a cut must still have it on disk.
   const auto now = std::chrono::steady_clock::now();
-  if (!options_.stats_path.empty() && now >= next_stats_write_) {
+  const LinkEvents link = link_events();
+  if (!options_.stats_path.empty() && (now >= next_stats_write_ || link != stats_link_written_)) {
     next_stats_write_ = now + std::chrono::seconds(1);
+    stats_link_written_ = link;
     if (!write_stats(options_.stats_path, stats())) log_line("could not write %s", options_.stats_path.c_str());
   }
 }

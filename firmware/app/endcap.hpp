@@ -101,6 +101,7 @@ class Endcap {
   std::thread loop_thread_;
   LoopStatus last_status_{};  // the newest the loop published (housekeeping thread)
   std::chrono::steady_clock::time_point next_stats_write_{};
+  LinkEvents stats_link_written_{};  // the link's events in the last snapshot written
 };
 
 }  // namespace tensegrity::fw::app

@@ -68,6 +68,7 @@ struct LinkEvents {
     loop_stalls += o.loop_stalls;
     return *this;
   }
+  bool operator==(const LinkEvents&) const = default;
 };
 
 class HostLink {
