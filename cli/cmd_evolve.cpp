@@ -35,9 +35,9 @@ struct EvolveArgs {
   std::string checkpoint;
   bool resume = false;
   std::string robot;
-  int population = 10;
-  int teams = 50;
-  int replace = 5;
+  int population = sim::evolve::EvolveConfig{}.population;
+  int teams = sim::evolve::EvolveConfig{}.teams;
+  int replace = sim::evolve::EvolveConfig{}.replace;
   std::string mutation = "gaussian";
   double sigma_m = -1.0;        // not given: the operator's own step (below)
   double sigma_final_m = -1.0;  // not given: sigma_m
@@ -121,6 +121,9 @@ sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig
   policy.provenance.episodes = evo.episodes();
   policy.provenance.score_m = score_m;
   policy.provenance.robot_hash = robot.hash;
+  policy.provenance.population = config.population;
+  policy.provenance.replace = config.replace;
+  policy.provenance.teams = config.teams;
   policy.provenance.mutation = sim::evolve::to_string(config.mutation);
   policy.provenance.sigma_m = config.sigma_m;
   policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;

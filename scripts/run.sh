@@ -7,7 +7,7 @@
 # It ends by printing the command that replays the run in a browser (tensegrity view).
 #   scripts/run.sh [--evolve [--seed N]] [--duration S]
 # The robot is DESIGN.md's with its struts' spin held (robots/superball-spin-held.json);
-# --evolve learns with 40 members per cable population (the CLI's default is the author's 10):
+# --evolve learns with 40 members per cable population (the CLI's default; the author's is 10):
 # seeds 1-10 all learned a 30-39 m gait in 5000 episodes so, against 3 in 10 with 10 members
 # (docs/results.md, "pop40"); seed 10 learns 39.1 m.
 set -euo pipefail

@@ -60,6 +60,24 @@ void read_gait(const json& provenance, const Robot& robot, const std::string& so
 
 namespace {
 
+// provenance.population / replace / teams: all three or none (policies from before
+// session 22 have none), each a size the coevolution could have run with.
+void read_sizes(const json& p, const std::string& source, Provenance& pr) {
+  const int given = static_cast<int>(p.contains("population")) + static_cast<int>(p.contains("replace")) +
+                    static_cast<int>(p.contains("teams"));
+  if (given == 0) return;
+  if (given != 3) fail(source, "provenance.population", "population, replace and teams go together");
+  const long long population = integer(p["population"], source, "provenance.population");
+  const long long replace = integer(p["replace"], source, "provenance.replace");
+  const long long teams = integer(p["teams"], source, "provenance.teams");
+  if (population < 2 || population > 100000) fail(source, "provenance.population", "must be within 2..100000");
+  if (replace < 1 || replace > population / 2) fail(source, "provenance.replace", "must be within 1..population/2");
+  if (teams < 1 || teams > 1000000) fail(source, "provenance.teams", "must be within 1..1000000");
+  pr.population = static_cast<int>(population);
+  pr.replace = static_cast<int>(replace);
+  pr.teams = static_cast<int>(teams);
+}
+
 // The provenance's fields beside the gait (read_gait), checked where present.
 void read_provenance(const json& p, const std::string& source, Provenance& pr) {
   pr.method = p.value("method", "");
@@ -68,6 +86,7 @@ void read_provenance(const json& p, const std::string& source, Provenance& pr) {
   if (p.contains("score_m")) pr.score_m = finite_number(p["score_m"], source, "provenance.score_m");
   pr.robot_hash = p.value("robot_hash", "");
   pr.created_by = p.value("created_by", "");
+  read_sizes(p, source, pr);
   const auto m = p.find("mutation");
   if (m == p.end()) return;
   if (!m->is_object()) fail(source, "provenance.mutation", "must be an object");
@@ -179,6 +198,11 @@ std::string policy_to_json(const Policy& policy) {
         {"created_by", policy.provenance.created_by}}},
   };
   const Provenance& pr = policy.provenance;
+  if (pr.population > 0) {
+    doc["provenance"]["population"] = pr.population;
+    doc["provenance"]["replace"] = pr.replace;
+    doc["provenance"]["teams"] = pr.teams;
+  }
   if (pr.sigma_m > 0.0) {
     doc["provenance"]["mutation"] = {{"operator", pr.mutation},
                                      {"sigma_m", pr.sigma_m},

@@ -39,6 +39,11 @@ struct Provenance {
   double sigma_final_m = 0.0;
   std::int64_t anneal_start_episodes = 0;
   std::int64_t anneal_episodes = 0;
+  // The coevolution's sizes (--population, --replace, --teams): the defaults changed
+  // in session 22, so a policy without them cannot say which it was bred with. 0: not recorded.
+  int population = 0;
+  int replace = 0;
+  int teams = 0;
   // How the policy's struts turned in the episode that scored it (sim::EpisodeResult):
   // a gait must roll, not skate on spinning struts. endcaps_touched_ground -1: not recorded.
   double axial_spin_rms_rad_per_s = 0.0;

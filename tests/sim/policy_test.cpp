@@ -131,6 +131,32 @@ TEST_F(PolicyFile, ProvenanceKeepsTheMutationScheduleAndChecksIt) {
   EXPECT_THAT(error_of(bad), HasSubstr("provenance.mutation: must be an object"));
 }
 
+TEST_F(PolicyFile, ProvenanceKeepsThePopulationSizesAndChecksThem) {
+  EXPECT_FALSE(good()["provenance"].contains("population")) << "not recorded: not written";
+  EXPECT_EQ(parse_policy(good().dump(), robot).provenance.population, 0);
+  Policy p = parse_policy(good().dump(), robot);
+  p.provenance.population = 40;
+  p.provenance.replace = 20;
+  p.provenance.teams = 50;
+  const json doc = json::parse(policy_to_json(p));
+  const Policy q = parse_policy(doc.dump(), robot);
+  EXPECT_EQ(q.provenance.population, 40);
+  EXPECT_EQ(q.provenance.replace, 20);
+  EXPECT_EQ(q.provenance.teams, 50);
+  json bad = doc;
+  bad["provenance"].erase("teams");
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.population: population, replace and teams go together"));
+  bad = doc;
+  bad["provenance"]["replace"] = 21;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.replace: must be within 1..population/2"));
+  bad = doc;
+  bad["provenance"]["population"] = 1;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.population: must be within 2..100000"));
+  bad = doc;
+  bad["provenance"]["teams"] = 2.5;
+  EXPECT_THAT(error_of(bad), HasSubstr("provenance.teams: must be an integer"));
+}
+
 TEST_F(PolicyFile, ProvenanceKeepsTheGaitsStrutGapsAndChecksThem) {
   Policy p = parse_policy(good().dump(), robot, "p.json");
   p.provenance.axial_spin_rms_rad_per_s = 0.5;

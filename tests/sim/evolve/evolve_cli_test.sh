@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# `tensegrity evolve`'s mutation schedule from the command line: the options go
+# `tensegrity evolve` from the command line: the mutation schedule's options go
 # together, the schedule reaches the policy's provenance and the --json summary, and
-# a checkpoint refuses to continue under another schedule.
+# a checkpoint refuses to continue under another schedule; the default population sizes.
 # Usage: evolve_cli_test.sh TENSEGRITY_BINARY
 set -euo pipefail
 
@@ -62,4 +62,22 @@ if "$tensegrity" evolve "${small[@]}" --mutation gaussian --sigma 0.015 --episod
   fail "a resume under another operator was accepted"
 fi
 grep -q 'mutation: "author" -> "gaussian"' "$work/out" || fail "the refusal does not name the operator: $(cat "$work/out")"
+# Without --population and --replace: 40 members, 20 replaced (docs/evolve.md), and a
+# run begun with the author's 10 and 5 is not silently continued under them.
+"$tensegrity" evolve --period 1 --complexity 2 --teams 4 --seed 3 --threads 1 --duration 0.5 --episodes 4 \
+  --out "$work/d.json" --log "$work/d.csv" --json > "$work/dsummary.json"
+/usr/bin/python3 - "$work" <<'PY' || fail "the default sizes are not 40 and 20"
+import json, sys
+c = json.load(open(f"{sys.argv[1]}/dsummary.json"))["config"]
+assert (c["population"], c["replace"], c["teams"]) == (40, 20, 4), c
+p = json.load(open(f"{sys.argv[1]}/d.json"))["provenance"]
+assert (p["population"], p["replace"], p["teams"]) == (40, 20, 4), p
+PY
+"$tensegrity" evolve --period 1 --complexity 2 --population 10 --replace 5 --teams 4 --seed 3 --threads 1 \
+  --duration 0.5 --episodes 4 --checkpoint "$work/p10" --out "$work/p10.json" --log "$work/p10.csv" > /dev/null
+if "$tensegrity" evolve --period 1 --complexity 2 --teams 4 --seed 3 --threads 1 --duration 0.5 --episodes 8 \
+    --checkpoint "$work/p10" --resume --out "$work/p10.json" --log "$work/p10.csv" > "$work/out" 2>&1; then
+  fail "a population-10 run was resumed under the default 40"
+fi
+grep -q "population: 10 -> 40" "$work/out" || fail "the refusal does not name the population: $(cat "$work/out")"
 echo "PASS"

@@ -31,6 +31,10 @@ inline EvolveConfig synthetic_config(FitnessMethod method, std::int64_t episodes
   c.method = method;
   c.episodes = episodes;
   c.seed = seed;
+  // The paper's Algorithm 1 sizes (the author's Config.ini), not the CLI's default:
+  // what these tests expect of selection and learning was derived for them.
+  c.population = 10;
+  c.replace = 5;
   c.cables = 24;
   c.complexity = 2;
   c.sigma_m = 0.01;
