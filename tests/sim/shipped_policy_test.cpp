@@ -32,7 +32,12 @@ TEST(ShippedPolicies, EachLoadsWithItsRobotAndRollsTheDistanceItWasScoredWith) {
     const Policy policy = load_policy(entry.path(), robot);
     EXPECT_EQ(policy.provenance.robot_hash, robot.hash)
         << entry.path() << ": made for another version of " << robot.name;
+    // Issue 14: every shipped policy learned from scratch by the coevolution, within
+    // the paper's 5000 episodes, with its seed recorded.
     EXPECT_GT(policy.provenance.episodes, 0) << entry.path();
+    EXPECT_LE(policy.provenance.episodes, 5000) << entry.path();
+    EXPECT_NE(policy.provenance.method, "hand") << entry.path();
+    EXPECT_GT(policy.provenance.seed, 0U) << entry.path();
     const EpisodeResult r = play(robot, policy);
     EXPECT_TRUE(r.feasible) << entry.path() << ": " << r.infeasible_reason;
     EXPECT_NEAR(r.distance_m, policy.provenance.score_m, 1e-6 * policy.provenance.score_m) << entry.path();

@@ -23,7 +23,7 @@ from browser_support import (Process, check_scene, chromium, free_port, http, sc
                              wait_for_server)
 
 NTRT_ROBOT = "robots/superball-ntrt2014.json"
-POLICY = "policies/superball-ntrt2014-t4-n5.json"
+POLICY = "policies/superball-ntrt2014-t4-n5-e5000.json"
 
 
 def check_read_only(port, paths):
