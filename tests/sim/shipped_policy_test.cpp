@@ -57,6 +57,12 @@ TEST(ShippedPolicies, TheMainJobsGaitRollsAsTheIssueAsks) {
   EXPECT_EQ(policy.provenance.method, "historical");
   EXPECT_LE(policy.provenance.episodes, 5000);
   EXPECT_GE(policy.provenance.score_m, 32.0);
+  // It is what `scripts/run.sh --evolve` learns (its seed and sizes), so a user's own
+  // run reproduces it; change both together.
+  EXPECT_EQ(policy.provenance.seed, 10U);
+  EXPECT_EQ(policy.provenance.population, 40);
+  EXPECT_EQ(policy.provenance.replace, 20);
+  EXPECT_EQ(policy.provenance.teams, 50);
 
   const EpisodeResult r = play(robot, policy);
   EXPECT_GE(r.distance_m, 32.0);
