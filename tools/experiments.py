@@ -37,6 +37,7 @@ import threading
 import time
 
 import sweep_figure
+from experiment_pins import pin_robot, pin_settings
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -68,9 +69,10 @@ def parse_args():
                    help="evolutions at once, one thread each (default: the cores, %(default)s)")
     p.add_argument("--duration", type=float, default=60.0,
                    help="episode length, s (default: the paper's %(default)s; shorter only for smoke tests)")
-    p.add_argument("--sigma", type=float, default=0.05, help="mutation step, m (default: %(default)s)")
+    p.add_argument("--sigma", type=float, default=None,
+                   help="mutation step, m (default: tensegrity evolve's schedule, docs/evolve.md)")
     p.add_argument("--sigma-final", type=float, default=None,
-                   help="anneal the step to this, m (default: no annealing; see docs/evolve.md)")
+                   help="anneal the step to this, m (default: no annealing once --sigma is given)")
     p.add_argument("--anneal-episodes", type=int, default=0,
                    help="episodes over which the step anneals (default: %(default)s)")
     p.add_argument("--plot-only", action="store_true", help="do not run anything; plot what is there")
@@ -81,7 +83,12 @@ def parse_args():
     if (a.sigma_final is None) != (a.anneal_episodes == 0):
         p.error("--sigma-final and --anneal-episodes go together")
     # Runs with another mutation than the default get their own directories.
-    a.mutation_tag = "" if a.sigma_final is None and a.sigma == 0.05 else (
+    if a.sigma_final is not None and a.sigma is None:
+        p.error("--sigma-final needs --sigma (the step it anneals from)")
+    a.step_args = [] if a.sigma is None else ["--sigma", f"{a.sigma:g}"]
+    if a.sigma_final is not None:
+        a.step_args += ["--sigma-final", f"{a.sigma_final:g}", "--anneal-episodes", str(a.anneal_episodes)]
+    a.mutation_tag = "" if a.sigma is None else (
         f"-m{a.sigma:g}" + ("" if a.sigma_final is None else f"-{a.sigma_final:g}-{a.anneal_episodes}"))
     a.method_seeds = a.method_seeds or a.seeds
     a.sweep_seeds = a.sweep_seeds or a.seeds
@@ -139,9 +146,7 @@ def run_one(a, key, r, progress):
     cmd = [a.tensegrity, "evolve", "--robot", a.robot, "--method", r["method"], "--period", f"{r['period']:g}",
            "--complexity", str(r["complexity"]), "--episodes", str(r["episodes"]), "--seed", str(r["seed"]),
            "--duration", f"{a.duration:g}", "--threads", "1", "--checkpoint", str(ckpt), "--out", str(d / "policy.json"),
-           "--log", str(d / "curve.csv"), "--json", "--sigma", f"{a.sigma:g}"]
-    if a.sigma_final is not None:
-        cmd += ["--sigma-final", f"{a.sigma_final:g}", "--anneal-episodes", str(a.anneal_episodes)]
+           "--log", str(d / "curve.csv"), "--json"] + a.step_args
     if (ckpt / "checkpoint.json").exists():
         cmd.append("--resume")
     progress(key, "started")
@@ -331,18 +336,6 @@ def report(a, runs):
     print(json.dumps(summary, indent=2))
 
 
-def pin_robot(a):
-    """OUT/robot.json is the robot every run there learned on. A run is found again by
-    its parameters alone, so another robot's runs must not be taken for this one's."""
-    out = pathlib.Path(a.out)
-    pinned, text = out / "robot.json", pathlib.Path(a.robot).read_text()
-    if pinned.exists() and pinned.read_text() != text and any(out.glob("runs/*/summary.json")):
-        sys.exit(f"experiments: the runs in {out} learned on the robot in {pinned}, not on {a.robot}; "
-                 f"give that robot (--robot {pinned}) or a new --out")
-    if not pinned.exists() or pinned.read_text() != text:
-        pinned.write_text(text)
-
-
 def main():
     a = parse_args()
     pathlib.Path(a.out).mkdir(parents=True, exist_ok=True)
@@ -353,6 +346,7 @@ def main():
         if not os.access(a.tensegrity, os.X_OK):
             sys.exit(f"experiments: {a.tensegrity} is not an executable (build: cmake --preset release && "
                      f"cmake --build --preset release --target tensegrity)")
+        pin_settings(a)
         print(f"experiments: {len(runs)} runs, {a.jobs} at a time, into {a.out}", flush=True)
         failures = run_all(a, runs)
     report(a, runs)

@@ -2,12 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 """tools/experiments.py's sweeps (Figures 8 and 9), with a stand-in for
 `tensegrity evolve` that answers at once: what a point records, and that runs
-learned on one robot are not reused for another.
+learned on one robot, or with other evolve settings, are not reused.
 
 Usage: experiments_test.py TOOLS_DIR
 """
 import csv
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -20,16 +21,23 @@ import sweep_figure  # noqa: E402
 
 # Odd seeds roll 35 m, even seeds stay at 8 m plus the period: a bimodal point.
 FAKE_EVOLVE = r'''#!/usr/bin/python3
-import csv, json, sys
-args = dict(zip(sys.argv[2::2], sys.argv[3::2]))
-seed, period = int(args["--seed"]), float(args["--period"])
+import csv, json, os, sys
+args, argv = {}, sys.argv[2:]
+for i, token in enumerate(argv):
+    if token.startswith("--"):
+        args[token] = argv[i + 1] if i + 1 < len(argv) and not argv[i + 1].startswith("--") else ""
+seed, period = int(args.get("--seed", 1)), float(args["--period"])
 best = 35.0 if seed % 2 else 8.0 + period
 with open(args["--log"], "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(["generation", "episodes", "best_score_m", "mean_score_m", "infeasible_rate", "best_so_far_m"])
     w.writerow([1, int(args["--episodes"]), best, best / 2, 0, best])
 open(args["--out"], "w").write("{}")
-print(json.dumps({"final_score_m": best, "episodes": int(args["--episodes"])}))
+# FAKE_POPULATION stands for another version of the program with other defaults.
+config = {"population": int(os.environ.get("FAKE_POPULATION", 40)), "replace": 20, "teams": 50,
+          "mutation": "gaussian", "sigma_m": float(args.get("--sigma", 0.05)), "sigma_final_m": 0.02,
+          "anneal_start_episodes": 2000, "anneal_episodes": 3000}
+print(json.dumps({"final_score_m": best, "episodes": int(args["--episodes"]), "config": config}))
 '''
 
 
@@ -48,11 +56,12 @@ class Point(unittest.TestCase):
 
 
 class Sweep(unittest.TestCase):
-    def run_sweep(self, root, robot, check=True):
+    def run_sweep(self, root, robot, check=True, env=None, more=()):
         cmd = [sys.executable, str(TOOLS / "experiments.py"), "--out", str(root / "out"), "--tensegrity",
                str(root / "fake"), "--robot", str(robot), "--figures", "8", "--periods", "4,6",
-               "--sweep-seeds", "3", "--sweep-episodes", "100", "--jobs", "2"]
-        return subprocess.run(cmd, capture_output=True, text=True, check=check)
+               "--sweep-seeds", "3", "--sweep-episodes", "100", "--jobs", "2", *more]
+        return subprocess.run(cmd, capture_output=True, text=True, check=check,
+                              env=None if env is None else dict(os.environ, **env))
 
     def test_each_point_records_every_seed_and_another_robot_is_refused(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -82,6 +91,17 @@ class Sweep(unittest.TestCase):
             # the same robot again reuses every finished run
             again = self.run_sweep(root, robot)
             self.assertEqual(again.stdout.count("done already"), 6)
+            settings = json.loads((root / "out" / "evolve-settings.json").read_text())["default"]
+            self.assertEqual((settings["population"], settings["sigma_final_m"]), (40, 0.02))
+            # a program whose defaults changed is refused before it runs, naming the field
+            other_version = self.run_sweep(root, robot, check=False, env={"FAKE_POPULATION": "10"})
+            self.assertNotEqual(other_version.returncode, 0)
+            self.assertIn("population: 40 -> 10", other_version.stderr)
+            # runs with a step of their own get their own ids and settings beside them
+            own_step = self.run_sweep(root, robot, more=("--sigma", "0.03"))
+            self.assertEqual(own_step.stdout.count("done already"), 0)
+            table = json.loads((root / "out" / "evolve-settings.json").read_text())
+            self.assertEqual((table["-m0.03"]["sigma_m"], table["default"]["sigma_m"]), (0.03, 0.05))
 
 
 if __name__ == "__main__":

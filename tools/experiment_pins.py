@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: Apache-2.0
+"""What every run in an experiments.py output directory must share besides its id: the
+robot, and the evolve settings the program resolved. A run is found again by its
+parameters alone, so a run made on another robot, or by a program whose defaults
+changed (sessions 22 and 23), must not be taken for this one's."""
+import json
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+
+def pin_robot(a):
+    """OUT/robot.json is the robot every run there learned on. A run is found again by
+    its parameters alone, so another robot's runs must not be taken for this one's."""
+    out = pathlib.Path(a.out)
+    pinned, text = out / "robot.json", pathlib.Path(a.robot).read_text()
+    if pinned.exists() and pinned.read_text() != text and any(out.glob("runs/*/summary.json")):
+        sys.exit(f"experiments: the runs in {out} learned on the robot in {pinned}, not on {a.robot}; "
+                 f"give that robot (--robot {pinned}) or a new --out")
+    if not pinned.exists() or pinned.read_text() != text:
+        pinned.write_text(text)
+
+
+# What decides a run's result besides its id: `tensegrity evolve`'s defaults for these
+# changed in sessions 22 (sizes) and 23 (step schedule).
+SETTINGS = ("population", "replace", "teams", "mutation", "sigma_m", "sigma_final_m", "anneal_start_episodes",
+            "anneal_episodes")
+
+
+def pin_settings(a):
+    """OUT/evolve-settings.json holds the evolve settings every run there used, as the
+    program resolved them. A one-episode probe asks this program what it would use, so
+    that runs of another version's defaults are refused before hours are spent."""
+    out = pathlib.Path(a.out)
+    with tempfile.TemporaryDirectory() as tmp:
+        probe = subprocess.run([a.tensegrity, "evolve", "--robot", a.robot, "--episodes", "1", "--duration", "0.01",
+                                "--period", "4", "--complexity", "2", "--threads", "1", "--out", f"{tmp}/p.json",
+                                "--log", f"{tmp}/c.csv", "--json"] + a.step_args,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if probe.returncode != 0:
+        sys.exit(f"experiments: tensegrity evolve refused the settings: {probe.stderr.strip()}")
+    config = json.loads(probe.stdout).get("config", {})
+    now = {k: config[k] for k in SETTINGS if k in config}
+    # Keyed by the runs' step tag: runs with their own step options have their own ids.
+    pinned, tag = out / "evolve-settings.json", a.mutation_tag or "default"
+    table = json.loads(pinned.read_text()) if pinned.exists() else {}
+    mine = [d for d in out.glob("runs/*/summary.json")
+            if (a.mutation_tag in d.parent.name if a.mutation_tag else "-m" not in d.parent.name)]
+    if tag in table and mine:
+        changed = [f"{k}: {table[tag].get(k)} -> {now.get(k)}" for k in SETTINGS if table[tag].get(k) != now.get(k)]
+        if changed:
+            sys.exit(f"experiments: the runs in {out} used other evolve settings ({pinned}): {', '.join(changed)}; "
+                     f"build the version they were made with, or give a new --out")
+    table[tag] = now
+    pinned.write_text(json.dumps(table, indent=2, sort_keys=True) + "\n")
+
+
