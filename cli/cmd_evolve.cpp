@@ -4,6 +4,7 @@
 // evaluated on threads, or with --mpi on the ranks of an MPI job (cli/evolve_mpi).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -39,10 +40,13 @@ struct EvolveArgs {
   int teams = sim::evolve::EvolveConfig{}.teams;
   int replace = sim::evolve::EvolveConfig{}.replace;
   std::string mutation = "gaussian";
-  double sigma_m = -1.0;        // not given: the operator's own step (below)
-  double sigma_final_m = -1.0;  // not given: sigma_m
-  std::int64_t anneal_episodes = 0;
-  std::int64_t anneal_start_episodes = 0;
+  // Negative: not given. With none of the four given the Gaussian operator breeds with
+  // kDefaultGaussianSchedule; with any given, the user sets the schedule: the step
+  // defaults to the operator's own, the final step to the step, the rest to 0.
+  double sigma_m = -1.0;
+  double sigma_final_m = -1.0;
+  std::int64_t anneal_episodes = -1;
+  std::int64_t anneal_start_episodes = -1;
   double duration_s = 60.0;
   std::string out;
   std::string log;
@@ -78,6 +82,30 @@ RobotArg read_robot_arg(const std::string& arg) {
   }
 }
 
+// The mutation step's schedule from the options (EvolveArgs says which defaults apply).
+void set_step_schedule(sim::evolve::EvolveConfig& config, const EvolveArgs& args) {
+  const bool given =
+      args.sigma_m >= 0.0 || args.sigma_final_m >= 0.0 || args.anneal_episodes >= 0 || args.anneal_start_episodes >= 0;
+  if (!given && config.mutation == sim::evolve::Mutation::gaussian) {
+    const auto& s = sim::evolve::kDefaultGaussianSchedule;
+    config.sigma_m = s.sigma_m;
+    config.sigma_final_m = s.sigma_final_m;
+    config.anneal_start_episodes = s.anneal_start_episodes;
+    config.anneal_episodes = s.anneal_episodes;
+    return;
+  }
+  // Each operator's own step: 0.05 m for the Gaussian (a tenth of the 0.5 m range),
+  // 0.03 of the range for the author's (NTRT's NeuroEvoMember::mutate).
+  const double range_m = config.max_rest_length_m - config.min_rest_length_m;
+  const double default_sigma_m = config.mutation == sim::evolve::Mutation::author
+                                     ? sim::evolve::kAuthorSigmaShareOfRange * range_m
+                                     : sim::evolve::kDefaultGaussianSchedule.sigma_m;
+  config.sigma_m = args.sigma_m < 0.0 ? default_sigma_m : args.sigma_m;
+  config.sigma_final_m = args.sigma_final_m < 0.0 ? config.sigma_m : args.sigma_final_m;
+  config.anneal_episodes = std::max<std::int64_t>(args.anneal_episodes, 0);
+  config.anneal_start_episodes = std::max<std::int64_t>(args.anneal_start_episodes, 0);
+}
+
 sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot& robot) {
   sim::evolve::EvolveConfig config;
   try {
@@ -90,15 +118,7 @@ sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot
   config.replace = args.replace;
   config.mutation = sim::evolve::parse_mutation(args.mutation);
   sim::evolve::set_robot(config, robot);
-  // Each operator's own step: 0.05 m for the Gaussian (a tenth of the 0.5 m range),
-  // 0.03 of the range for the author's (NTRT's NeuroEvoMember::mutate).
-  const double range_m = config.max_rest_length_m - config.min_rest_length_m;
-  const double default_sigma_m =
-      config.mutation == sim::evolve::Mutation::author ? sim::evolve::kAuthorSigmaShareOfRange * range_m : 0.05;
-  config.sigma_m = args.sigma_m < 0.0 ? default_sigma_m : args.sigma_m;
-  config.sigma_final_m = args.sigma_final_m < 0.0 ? config.sigma_m : args.sigma_final_m;
-  config.anneal_episodes = args.anneal_episodes;
-  config.anneal_start_episodes = args.anneal_start_episodes;
+  set_step_schedule(config, args);
   config.seed = args.seed;
   config.episodes = args.episodes;
   config.complexity = args.complexity;
@@ -282,14 +302,17 @@ void add_mutation_options(CLI::App& cmd, EvolveArgs& args) {
       ->capture_default_str()
       ->check(CLI::IsMember({"author", "gaussian"}));
   cmd.add_option("--sigma", args.sigma_m,
-                 "Mutation step, metres, clamped to the limits (default: 0.05 for gaussian, 0.03 of the "
-                 "rest-length range for author)")
+                 "Mutation step, metres, clamped to the limits (default for gaussian: 0.05, annealed to 0.02 "
+                 "over episodes 2000-5000 unless a step option is given; for author: 0.03 of the rest-length "
+                 "range, constant)")
       ->check(CLI::Range(0.0, 10.0));
   // The schedule's three options go together: a step given without its episodes
   // (or the reverse) would be silently ignored.
-  CLI::Option* sigma_final = cmd.add_option("--sigma-final", args.sigma_final_m,
-                                            "Mutation step after --anneal-episodes, metres (default: no annealing)")
-                                 ->check(CLI::Range(0.0, 10.0));
+  CLI::Option* sigma_final =
+      cmd.add_option("--sigma-final", args.sigma_final_m,
+                     "Mutation step after --anneal-episodes, metres (default: no annealing once any step option "
+                     "is given)")
+          ->check(CLI::Range(0.0, 10.0));
   CLI::Option* anneal = cmd.add_option("--anneal-episodes", args.anneal_episodes,
                                        "Episodes over which the step goes geometrically from --sigma to --sigma-final")
                             ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));

@@ -9,6 +9,7 @@
 
 #include "sim/core_controller.hpp"
 #include "sim/episode.hpp"
+#include "sim/evolve/config.hpp"
 #include "sim/policy.hpp"
 
 namespace tensegrity::sim {
@@ -57,12 +58,18 @@ TEST(ShippedPolicies, TheMainJobsGaitRollsAsTheIssueAsks) {
   EXPECT_EQ(policy.provenance.method, "historical");
   EXPECT_LE(policy.provenance.episodes, 5000);
   EXPECT_GE(policy.provenance.score_m, 32.0);
-  // It is what `scripts/run.sh --evolve` learns (its seed and sizes), so a user's own
-  // run reproduces it; change both together.
-  EXPECT_EQ(policy.provenance.seed, 10U);
+  // It is what `scripts/run.sh --evolve` learns (its seed, sizes and step schedule: the
+  // CLI's defaults), so a user's own run reproduces it; change them together.
+  EXPECT_EQ(policy.provenance.seed, 1U);
   EXPECT_EQ(policy.provenance.population, 40);
   EXPECT_EQ(policy.provenance.replace, 20);
   EXPECT_EQ(policy.provenance.teams, 50);
+  EXPECT_EQ(policy.provenance.mutation, "gaussian");
+  const evolve::StepSchedule& step = evolve::kDefaultGaussianSchedule;
+  EXPECT_DOUBLE_EQ(policy.provenance.sigma_m, step.sigma_m);
+  EXPECT_DOUBLE_EQ(policy.provenance.sigma_final_m, step.sigma_final_m);
+  EXPECT_EQ(policy.provenance.anneal_start_episodes, step.anneal_start_episodes);
+  EXPECT_EQ(policy.provenance.anneal_episodes, step.anneal_episodes);
 
   const EpisodeResult r = play(robot, policy);
   EXPECT_GE(r.distance_m, 32.0);

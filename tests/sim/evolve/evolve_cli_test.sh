@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # `tensegrity evolve` from the command line: the mutation schedule's options go
 # together, the schedule reaches the policy's provenance and the --json summary, and
-# a checkpoint refuses to continue under another schedule; the default population sizes.
+# a checkpoint refuses to continue under another schedule; the default population sizes
+# and step schedule.
 # Usage: evolve_cli_test.sh TENSEGRITY_BINARY
 set -euo pipefail
 
@@ -80,4 +81,21 @@ if "$tensegrity" evolve --period 1 --complexity 2 --teams 4 --seed 3 --threads 1
   fail "a population-10 run was resumed under the default 40"
 fi
 grep -q "population: 10 -> 40" "$work/out" || fail "the refusal does not name the population: $(cat "$work/out")"
+# Without a step option the Gaussian operator anneals 0.05 m to 0.02 m over episodes
+# 2000-5000 (docs/evolve.md); one step option makes the schedule the user's: constant.
+/usr/bin/python3 - "$work" <<'PY' || fail "the default step schedule is not 0.05 -> 0.02 over 2000-5000"
+import json, sys
+c = json.load(open(f"{sys.argv[1]}/dsummary.json"))["config"]
+got = (c["mutation"], c["sigma_m"], c["sigma_final_m"], c["anneal_start_episodes"], c["anneal_episodes"])
+assert got == ("gaussian", 0.05, 0.02, 2000, 3000), c
+m = json.load(open(f"{sys.argv[1]}/d.json"))["provenance"]["mutation"]
+assert (m["sigma_final_m"], m["anneal_start_episodes"], m["anneal_episodes"]) == (0.02, 2000, 3000), m
+PY
+"$tensegrity" evolve "${small[@]}" --sigma 0.03 --episodes 4 --out "$work/s.json" --log "$work/s.csv" \
+  --json > "$work/ssummary.json"
+/usr/bin/python3 - "$work" <<'PY' || fail "--sigma alone does not give a constant step"
+import json, sys
+c = json.load(open(f"{sys.argv[1]}/ssummary.json"))["config"]
+assert (c["sigma_m"], c["sigma_final_m"], c["anneal_episodes"]) == (0.03, 0.03, 0), c
+PY
 echo "PASS"
