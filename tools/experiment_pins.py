@@ -11,8 +11,7 @@ import tempfile
 
 
 def pin_robot(a):
-    """OUT/robot.json is the robot every run there learned on. A run is found again by
-    its parameters alone, so another robot's runs must not be taken for this one's."""
+    """OUT/robot.json is the robot every run there learned on."""
     out = pathlib.Path(a.out)
     pinned, text = out / "robot.json", pathlib.Path(a.robot).read_text()
     if pinned.exists() and pinned.read_text() != text and any(out.glob("runs/*/summary.json")):
@@ -44,9 +43,13 @@ def pin_settings(a):
     now = {k: config[k] for k in SETTINGS if k in config}
     # Keyed by the runs' step tag: runs with their own step options have their own ids.
     pinned, tag = out / "evolve-settings.json", a.mutation_tag or "default"
-    table = json.loads(pinned.read_text()) if pinned.exists() else {}
+    try:
+        table = json.loads(pinned.read_text()) if pinned.exists() else {}
+    except json.JSONDecodeError as e:
+        sys.exit(f"experiments: {pinned} is not JSON ({e}); restore it from git or give a new --out")
+    # A tag ends its runs' ids; "-m0.05" must not claim the runs of "-m0.05-0.02-3000".
     mine = [d for d in out.glob("runs/*/summary.json")
-            if (a.mutation_tag in d.parent.name if a.mutation_tag else "-m" not in d.parent.name)]
+            if (d.parent.name.endswith(a.mutation_tag) if a.mutation_tag else "-m" not in d.parent.name)]
     if tag in table and mine:
         changed = [f"{k}: {table[tag].get(k)} -> {now.get(k)}" for k in SETTINGS if table[tag].get(k) != now.get(k)]
         if changed:
@@ -54,5 +57,3 @@ def pin_settings(a):
                      f"build the version they were made with, or give a new --out")
     table[tag] = now
     pinned.write_text(json.dumps(table, indent=2, sort_keys=True) + "\n")
-
-

@@ -102,6 +102,10 @@ class Sweep(unittest.TestCase):
             self.assertEqual(own_step.stdout.count("done already"), 0)
             table = json.loads((root / "out" / "evolve-settings.json").read_text())
             self.assertEqual((table["-m0.03"]["sigma_m"], table["default"]["sigma_m"]), (0.03, 0.05))
+            # a damaged settings file is named, not a traceback
+            (root / "out" / "evolve-settings.json").write_text("{bad")
+            damaged = self.run_sweep(root, robot, check=False)
+            self.assertIn("evolve-settings.json is not JSON", damaged.stderr)
 
 
 if __name__ == "__main__":
