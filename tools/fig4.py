@@ -168,6 +168,9 @@ def main(argv=None):
     cables = len(doc["cables"])
     if not 0 <= a.cable < cables:
         sys.exit(f"--cable {a.cable}: the robot has cables 0-{cables - 1}")
+    if a.rest_length > doc["cable"]["max_rest_length_m"]:
+        sys.exit(f"--rest-length {a.rest_length:g}: above the robot's longest rest length "
+                 f"(cable.max_rest_length_m {doc['cable']['max_rest_length_m']:g})")
     if a.rest_length < doc["cable"]["min_rest_length_m"]:
         a.set = a.set + [f"cable.min_rest_length_m={a.rest_length}"]
     robot = write_robot(a, out)

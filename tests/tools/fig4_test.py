@@ -54,6 +54,13 @@ class Fig4(unittest.TestCase):
             self.assertNotEqual(done.returncode, 0)
             self.assertIn("--cable 24: the robot has cables 0-23", done.stderr)
 
+    def test_a_rest_length_above_the_robots_longest_is_named(self):
+        with tempfile.TemporaryDirectory() as d:
+            done = fig4(d, "--rest-length", "1.2")
+            self.assertNotEqual(done.returncode, 0)
+            self.assertIn("--rest-length 1.2: above the robot's longest rest length (cable.max_rest_length_m 1.1)",
+                          done.stderr)
+
     def test_an_average_window_longer_than_the_episode_is_refused(self):
         with tempfile.TemporaryDirectory() as d:
             done = fig4(d, "--average-s", "5")
