@@ -149,9 +149,10 @@ def write_csv(path, rows):
         w.writerows(rows)
 
 
-def every_cable(a, robot, robot_doc, held):
-    """Pull each cable in turn: the paper's muscle numbering need not be this robot's."""
-    table = [pull(a, robot, robot_doc, c, held)[1] for c in range(len(held))]
+def every_cable(a, robot, robot_doc, held, counts):
+    """Pull each cable in turn (`counts`: --cable's, already played): the paper's muscle
+    numbering need not be this robot's."""
+    table = [counts if c == a.cable else pull(a, robot, robot_doc, c, held)[1] for c in range(len(held))]
     write_csv(pathlib.Path(a.out) / "fig4_every_cable.csv", table)
     shortened = [t["others_shortened"] for t in table]
     return {"cables_pulled": len(table), "others_shortened_median": statistics.median(shortened),
@@ -165,13 +166,19 @@ def main(argv=None):
     out = pathlib.Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = json.loads(pathlib.Path(a.robot).read_text())
-    cables = len(doc["cables"])
+    try:  # the fields this tool reads before `tensegrity sim` validates the whole file
+        cables = len(doc["cables"])
+        shortest, longest = doc["cable"]["min_rest_length_m"], doc["cable"]["max_rest_length_m"]
+        doc["cable"]["initial_rest_length_m"]
+    except (KeyError, TypeError) as e:
+        sys.exit(f"--robot {a.robot}: missing field {e} (cables, cable.min_rest_length_m, "
+                 f"cable.max_rest_length_m, cable.initial_rest_length_m)")
     if not 0 <= a.cable < cables:
         sys.exit(f"--cable {a.cable}: the robot has cables 0-{cables - 1}")
-    if a.rest_length > doc["cable"]["max_rest_length_m"]:
+    if a.rest_length > longest:
         sys.exit(f"--rest-length {a.rest_length:g}: above the robot's longest rest length "
-                 f"(cable.max_rest_length_m {doc['cable']['max_rest_length_m']:g})")
-    if a.rest_length < doc["cable"]["min_rest_length_m"]:
+                 f"(cable.max_rest_length_m {longest:g})")
+    if a.rest_length < shortest:
         a.set = a.set + [f"cable.min_rest_length_m={a.rest_length}"]
     robot = write_robot(a, out)
     robot_doc = json.loads(robot.read_text())
@@ -186,7 +193,7 @@ def main(argv=None):
                # a slack cable at rest means the structure does not hold its shape (collapsed)
                "held_slack_cables": sum(1 for x in held if x <= robot_doc["cable"]["initial_rest_length_m"])}
     if a.every_cable:
-        summary["every_cable"] = every_cable(a, robot, robot_doc, held)
+        summary["every_cable"] = every_cable(a, robot, robot_doc, held, counts)
     (out / "fig4_pull.json").write_text(json.dumps(summary, indent=2) + "\n")
     plot(out / "fig4_pull.png", rows, a)
     print(f"cable {a.cable} to {a.rest_length:g} m: its length changed {counts['pulled_cable_change_m']:+.3f} m; "

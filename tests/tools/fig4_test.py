@@ -61,6 +61,17 @@ class Fig4(unittest.TestCase):
             self.assertIn("--rest-length 1.2: above the robot's longest rest length (cable.max_rest_length_m 1.1)",
                           done.stderr)
 
+    def test_a_robot_file_without_rest_lengths_is_named(self):
+        with tempfile.TemporaryDirectory() as d:
+            bad = pathlib.Path(d) / "bad.json"
+            doc = json.loads((ROBOTS / "superball-ntrt2014.json").read_text())
+            del doc["cable"]["max_rest_length_m"]
+            bad.write_text(json.dumps(doc))
+            done = subprocess.run(["/usr/bin/python3", str(TOOLS / "fig4.py"), "--out", str(pathlib.Path(d) / "o"),
+                                   "--tensegrity", str(TENSEGRITY), "--robot", str(bad)], capture_output=True, text=True)
+            self.assertNotEqual(done.returncode, 0)
+            self.assertIn("missing field 'max_rest_length_m'", done.stderr)
+
     def test_an_average_window_longer_than_the_episode_is_refused(self):
         with tempfile.TemporaryDirectory() as d:
             done = fig4(d, "--average-s", "5")
