@@ -52,9 +52,17 @@ fw::app::EndcapAppConfig endcap_config(const LauncherConfig& lc, int motors, std
   c.load_cell_sample_timeout_s = 0.02;
   // Real time on a shared 2-core host: an end cap's loop (or the emulator, whose
   // catch-up ticks then pass without frames) was seen to stall beyond the default
-  // 50 ms while twelve programs start, and its drives then quick-stop it at boot.
-  // Lockstep keeps the default: its end caps beat in SYNC time, which is device time.
-  if (lc.mode == StepperMode::realtime) c.drive_consumer_heartbeat_s = kRealtimeConsumerHeartbeatS;
+  // 50 ms while twelve programs start, and its drives then quick-stop it at boot;
+  // and a restarted end cap latched stale_position on a 20 ms gap in a CI run. Each
+  // side's silence timeouts are then the host's stall bound, not the bus's.
+  // Lockstep keeps the defaults: everything there runs in device time.
+  if (lc.mode == StepperMode::realtime) {
+    c.drive_consumer_heartbeat_s = kRealtimeConsumerHeartbeatS;
+    c.drive_heartbeat_timeout_s = kRealtimeSilenceTimeoutS;
+    c.load_cell_heartbeat_timeout_s = kRealtimeSilenceTimeoutS;
+    c.load_cell_sample_timeout_s = kRealtimeSilenceTimeoutS;
+    c.drive_position_timeout_s = kRealtimeSilenceTimeoutS;
+  }
   c.start_on_boot = false;
   c.stats_log_period_s = 10.0;
   return c;

@@ -113,6 +113,9 @@ class ProcessLauncher final : public EndcapProcesses {
 // The drives' consumer heartbeat time the launcher configures in real time (the
 // end cap's default, 50 ms, in lockstep).
 inline constexpr double kRealtimeConsumerHeartbeatS = 0.2;
+// The end cap's own silence timeouts in real time (drive and load-cell heartbeats,
+// drive positions, load-cell samples; 20-100 ms by default, kept in lockstep).
+inline constexpr double kRealtimeSilenceTimeoutS = 0.2;
 
 // Free UDP ports on 127.0.0.1 for the end caps' buses, from the kLauncherPortSpan
 // ports just below the kernel's ephemeral range (bound together, then released).
