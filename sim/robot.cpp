@@ -109,6 +109,8 @@ void parse_cable_defaults(const Reader& r, Robot& robot) {
   robot.motor.speed_m_per_s = cable.positive("motor_speed_m_per_s", 0.0, true);
   robot.motor.cutoff_tension_n = cable.positive("cutoff_tension_n", 0.0, true);
   robot.motor.hard_limit_tension_n = cable.positive("hard_limit_tension_n", 0.0, true);
+  const auto& names = core::kOverloadNames;
+  robot.motor.overload = static_cast<core::Overload>(cable.choice("overload", {names[0], names[1]}, 0));
   // The end cap's own check of its limits (its config is checked by the same).
   if (const core::LimitsError e = core::validate(robot.motor); e != core::LimitsError::none) {
     cable.fail(core::field_of(e), core::describe(e));

@@ -118,13 +118,16 @@ void parse_spool_and_limits(const Reader& top, EndcapAppConfig& c) {
   c.counts_per_rev = spool.positive("counts_per_rev", 0, true);
 
   const Reader limits = top.object("limits");
-  limits.only({"min_rest_length_m", "max_rest_length_m", "speed_m_per_s", "cutoff_tension_n", "hard_limit_tension_n"});
+  limits.only({"min_rest_length_m", "max_rest_length_m", "speed_m_per_s", "cutoff_tension_n", "hard_limit_tension_n",
+               "overload"});
   core::MotorLimits& l = c.limits;
   l.min_rest_length_m = limits.positive("min_rest_length_m", 0, true);
   l.max_rest_length_m = limits.positive("max_rest_length_m", 0, true);
   l.speed_m_per_s = limits.positive("speed_m_per_s", 0, true);
   l.cutoff_tension_n = limits.positive("cutoff_tension_n", 0, true);
   l.hard_limit_tension_n = limits.positive("hard_limit_tension_n", 0, true);
+  const auto& names = core::kOverloadNames;
+  l.overload = static_cast<core::Overload>(limits.choice("overload", {names[0], names[1]}, 0));
   if (const core::LimitsError e = core::validate(l); e != core::LimitsError::none) {
     limits.fail(core::field_of(e), core::describe(e));
   }
@@ -211,7 +214,8 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
         {"max_rest_length_m", l.max_rest_length_m},
         {"speed_m_per_s", l.speed_m_per_s},
         {"cutoff_tension_n", l.cutoff_tension_n},
-        {"hard_limit_tension_n", l.hard_limit_tension_n}}},
+        {"hard_limit_tension_n", l.hard_limit_tension_n},
+        {"overload", core::to_string(l.overload)}}},
       {"initial_rest_length_m", c.initial_rest_length_m},
       {"storage_dir", c.storage_dir.string()},
       {"loop", {{"rate_hz", c.loop_rate_hz}, {"mode", to_string(c.mode)}}},

@@ -34,4 +34,6 @@ const char* field_of(LimitsError error) noexcept {
   }
 }
 
+const char* to_string(Overload overload) noexcept { return kOverloadNames[overload == Overload::pay_out ? 1 : 0]; }
+
 }  // namespace tensegrity::core

@@ -10,6 +10,15 @@ namespace tensegrity::core {
 inline constexpr std::size_t kMaxMotorsPerEndcap = 4;
 inline constexpr std::size_t kMaxComplexity = 16;
 
+// What a motor does while its cable is above the cut-off tension.
+enum class Overload : std::uint8_t {
+  hold,     // stop shortening, keep the length (DESIGN.md's guard)
+  pay_out,  // give cable at the motor speed until the tension is back under the cut-off: the
+            // paper's back-driven motor that feeds out cable (Iscen et al., section 3), and
+            // NTRT's muscle, whose moveMotors raises the preferred length to keep k (L - L0)
+            // at maxTens (tgLinearString.cpp, 2014)
+};
+
 struct MotorLimits {
   double min_rest_length_m = 0.6;
   double max_rest_length_m = 1.1;
@@ -18,6 +27,7 @@ struct MotorLimits {
   double cutoff_tension_n = 400.0;
   // Above this the end cap faults and holds until the fault is cleared.
   double hard_limit_tension_n = 500.0;
+  Overload overload = Overload::hold;
 };
 
 enum class LimitsError : std::uint8_t {
@@ -33,5 +43,10 @@ LimitsError validate(const MotorLimits& limits) noexcept;
 const char* describe(LimitsError error) noexcept;
 // The MotorLimits field an error is reported at ("max_rest_length_m", ...).
 const char* field_of(LimitsError error) noexcept;
+
+// "hold" / "pay_out": the one spelling of Overload in robot files and end-cap configs,
+// in the order of the enum.
+inline constexpr const char* kOverloadNames[] = {"hold", "pay_out"};
+const char* to_string(Overload overload) noexcept;
 
 }  // namespace tensegrity::core

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "firmware/core/motor_loop.hpp"
 
+#include <algorithm>
+
 #include "firmware/core/rate_limit.hpp"
 
 namespace tensegrity::core {
@@ -14,10 +16,16 @@ std::uint8_t MotorLoop::step(double preferred_m, double tension_n, double dt_s, 
   double next = move_toward(commanded_m_, target, max_step);
   if (next != target) flags |= kMotorRateLimited;
 
-  // Shortening raises tension; paying out never does, so only shortening is cut.
-  if (next < commanded_m_ && tension_n > limits.cutoff_tension_n) {
-    next = commanded_m_;
-    flags |= kMotorCutOff;
+  if (tension_n > limits.cutoff_tension_n) {
+    // Shortening raises tension; paying out never does, so only shortening is cut. A
+    // yielding motor also gives cable, as far as its speed and the longest rest length allow.
+    const double floor_m = limits.overload == Overload::pay_out
+                               ? std::min(commanded_m_ + max_step, limits.max_rest_length_m)
+                               : commanded_m_;
+    if (next < floor_m) {
+      next = std::max(floor_m, commanded_m_);
+      flags |= kMotorCutOff;
+    }
   }
   commanded_m_ = next;
   return flags;

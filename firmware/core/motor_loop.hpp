@@ -2,7 +2,8 @@
 #pragma once
 // One motor's loop: moves the commanded rest length toward the preferred one at no
 // more than the motor speed, within the rest-length limits, and refuses to shorten
-// the cable while its tension is above the cut-off.
+// the cable while its tension is above the cut-off (MotorLimits::overload says whether
+// it then holds or pays out).
 #include <cstdint>
 
 #include "firmware/core/limits.hpp"

@@ -30,12 +30,14 @@ class Recorder final : public TelemetrySink {
       max_rate_ = std::max(max_rate_, std::fabs(rest[m] - last_[m]) / model.dt_s());
       min_ = std::min(min_, rest[m]);
       max_ = std::max(max_, rest[m]);
+      rose_ = rose_ || rest[m] > last_[m];
       last_[m] = rest[m];
     }
     ++rows_;
   }
   std::vector<double> last_;
   double max_rate_ = 0.0, min_ = 1e9, max_ = -1e9;
+  bool rose_ = false;  // some rest length grew
   int rows_ = 0;
 };
 
@@ -200,6 +202,34 @@ TEST(Episode, CoreCutOffLimitsTensionTheModelSees) {
   ConstantController plain(robot.motor.min_rest_length_m);
   EXPECT_TRUE(run_episode(robot, core, options).feasible);
   EXPECT_FALSE(run_episode(robot, plain, options).feasible);
+}
+
+TEST(Episode, PayingOutMotorsGiveCableAndKeepTensionNearTheCutOff) {
+  // The same hard shortening with motors that yield: above the cut-off they give cable
+  // (the table never asks for it), so the peak tension is no higher than with holding.
+  Robot robot = superball();
+  robot.motor.cutoff_tension_n = 150.0;
+  robot.motor.hard_limit_tension_n = 300.0;
+  EpisodeOptions options;
+  options.duration_s = 5.0;
+  const Policy shortest = constant_policy(robot, robot.motor.min_rest_length_m);
+  CoreController holding(robot, shortest);
+  Recorder held;
+  options.telemetry = &held;
+  const auto hold = run_episode(robot, holding, options);
+  EXPECT_FALSE(held.rose_);
+
+  robot.motor.overload = core::Overload::pay_out;
+  CoreController yielding(robot, shortest);
+  Recorder yielded;
+  options.telemetry = &yielded;
+  const auto pay_out = run_episode(robot, yielding, options);
+  ASSERT_TRUE(hold.feasible);
+  ASSERT_TRUE(pay_out.feasible);
+  EXPECT_TRUE(yielded.rose_);
+  EXPECT_LE(yielded.max_rate_, robot.motor.speed_m_per_s * (1 + 1e-9));
+  EXPECT_LE(pay_out.max_tension_n, hold.max_tension_n);
+  EXPECT_LT(pay_out.mean_tension_n, hold.mean_tension_n);
 }
 
 }  // namespace

@@ -194,6 +194,20 @@ TEST(Robot, StartPoseIsOptionalAndValidated) {
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: start.pose: must be \"face_down\" or \"description\""));
 }
 
+TEST(Robot, OverloadIsOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(plain.motor.overload, core::Overload::hold);
+  doc["cable"]["overload"] = "pay_out";
+  const Robot yielding = parse_robot(doc.dump(), "test.json");
+  EXPECT_EQ(yielding.motor.overload, core::Overload::pay_out);
+  EXPECT_NE(yielding.hash, plain.hash);
+  doc["cable"]["overload"] = "slip";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.overload: must be \"hold\" or \"pay_out\" (got \"slip\")"));
+  doc["cable"]["overload"] = 1;
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.overload: must be a string"));
+}
+
 TEST(Robot, EngineAndAxialSpinAreOptionalAndValidated) {
   json doc = superball_json();
   const Robot plain = parse_robot(doc.dump(), "test.json");

@@ -48,6 +48,7 @@ TEST(EndcapConfig, ParsesAFullConfig) {
   EXPECT_EQ(c.mode, LoopMode::lockstep);
   EXPECT_EQ(c.period_ns(), 2'000'000);
   EXPECT_DOUBLE_EQ(c.limits.hard_limit_tension_n, 500.0);
+  EXPECT_EQ(c.limits.overload, core::Overload::hold) << "absent: DESIGN.md's guard";
   EXPECT_FALSE(c.start_on_boot);
 }
 
@@ -81,6 +82,10 @@ TEST(EndcapConfig, ErrorsNameTheField) {
   j = example();
   j["limits"]["hard_limit_n"] = 500;  // misspelt: must not fall back to a default silently
   EXPECT_THAT(error_of(j), HasSubstr("limits.hard_limit_n: unknown field"));
+
+  j = example();
+  j["limits"]["overload"] = "yield";
+  EXPECT_THAT(error_of(j), HasSubstr("limits.overload: must be \"hold\" or \"pay_out\" (got \"yield\")"));
 
   j = example();
   j["nodes"]["drives"] = {1, 1};
@@ -161,6 +166,7 @@ void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
   EXPECT_EQ(a.limits.speed_m_per_s, b.limits.speed_m_per_s);
   EXPECT_EQ(a.limits.cutoff_tension_n, b.limits.cutoff_tension_n);
   EXPECT_EQ(a.limits.hard_limit_tension_n, b.limits.hard_limit_tension_n);
+  EXPECT_EQ(a.limits.overload, b.limits.overload);
   EXPECT_EQ(a.initial_rest_length_m, b.initial_rest_length_m);
   EXPECT_EQ(a.storage_dir, b.storage_dir);
   EXPECT_EQ(a.loop_rate_hz, b.loop_rate_hz);
@@ -183,6 +189,7 @@ TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
   full["timeouts"] = {{"drive_heartbeat_s", 0.25},  {"load_cell_heartbeat_s", 0.3},
                       {"load_cell_sample_s", 0.05}, {"drive_position_s", 0.04},
                       {"endcap_heartbeat_s", 0.02}, {"drive_consumer_heartbeat_s", 0.07}};
+  full["limits"]["overload"] = "pay_out";
   full["drive_abort_connection"] = "fault";
   full["start_on_boot"] = true;
   full["stats_log_period_s"] = 2.5;

@@ -74,6 +74,47 @@ TEST(MotorLoop, CutOffStopsShorteningButAllowsLengthening) {
   EXPECT_LT(motor.commanded_m(), 0.9);
 }
 
+TEST(MotorLoop, PayOutGivesCableAtMotorSpeedAboveTheCutOff) {
+  MotorLimits limits;
+  limits.overload = Overload::pay_out;
+  MotorLoop motor;
+  motor.reset(0.9);
+  const double step_m = limits.speed_m_per_s * kDt;
+  // Asked to shorten or to hold, an overloaded motor gives one step of cable.
+  auto flags = motor.step(0.7, limits.cutoff_tension_n + 1.0, kDt, limits);
+  EXPECT_DOUBLE_EQ(motor.commanded_m(), 0.9 + step_m);
+  EXPECT_TRUE(flags & kMotorCutOff);
+  flags = motor.step(motor.commanded_m(), limits.cutoff_tension_n + 1.0, kDt, limits);
+  EXPECT_DOUBLE_EQ(motor.commanded_m(), 0.9 + 2 * step_m);
+  EXPECT_TRUE(flags & kMotorCutOff);
+  // Asked to lengthen, it never goes faster than the motor speed.
+  const double before = motor.commanded_m();
+  flags = motor.step(1.1, limits.cutoff_tension_n + 1.0, kDt, limits);
+  EXPECT_DOUBLE_EQ(motor.commanded_m(), before + step_m);
+  EXPECT_FALSE(flags & kMotorCutOff);
+  // Under the cut-off (or at it) it follows its table again.
+  motor.step(0.7, limits.cutoff_tension_n, kDt, limits);
+  EXPECT_DOUBLE_EQ(motor.commanded_m(), before);
+}
+
+TEST(MotorLoop, PayOutStopsAtTheLongestRestLength) {
+  MotorLimits limits;
+  limits.overload = Overload::pay_out;
+  MotorLoop motor;
+  motor.reset(limits.max_rest_length_m - 0.5 * limits.speed_m_per_s * kDt);
+  motor.step(0.7, limits.cutoff_tension_n + 1.0, kDt, limits);
+  EXPECT_EQ(motor.commanded_m(), limits.max_rest_length_m);
+  const auto flags = motor.step(0.7, limits.cutoff_tension_n + 1.0, kDt, limits);
+  EXPECT_EQ(motor.commanded_m(), limits.max_rest_length_m);
+  EXPECT_TRUE(flags & kMotorCutOff);
+}
+
+TEST(MotorLoop, HoldIsTheDefaultOverload) {
+  EXPECT_EQ(MotorLimits{}.overload, Overload::hold);
+  EXPECT_STREQ(to_string(Overload::hold), "hold");
+  EXPECT_STREQ(to_string(Overload::pay_out), "pay_out");
+}
+
 TEST(MotorLoop, ZeroOrNegativeDtHolds) {
   MotorLimits limits;
   MotorLoop motor;
