@@ -190,12 +190,19 @@ TEST(Episode, CoreDrivenConstantPolicyEqualsConstantController) {
   EXPECT_EQ(a.mean_tension_n, b.mean_tension_n);
 }
 
-TEST(Episode, CoreCutOffLimitsTensionTheModelSees) {
-  // Shortening every cable hard: the cores stop shortening above the cut-off, so the
-  // robot stays feasible where a plain controller would not.
+// The 1.7 m robot with a low cut-off and hard limit, which shortening every cable
+// to its shortest rest length reaches within 5 s.
+Robot low_limit_superball() {
   Robot robot = superball();
   robot.motor.cutoff_tension_n = 150.0;
   robot.motor.hard_limit_tension_n = 300.0;
+  return robot;
+}
+
+TEST(Episode, CoreCutOffLimitsTensionTheModelSees) {
+  // Shortening every cable hard: the cores stop shortening above the cut-off, so the
+  // robot stays feasible where a plain controller would not.
+  const Robot robot = low_limit_superball();
   EpisodeOptions options;
   options.duration_s = 5.0;
   CoreController core(robot, constant_policy(robot, robot.motor.min_rest_length_m));
@@ -207,9 +214,7 @@ TEST(Episode, CoreCutOffLimitsTensionTheModelSees) {
 TEST(Episode, PayingOutMotorsGiveCableAndKeepTensionNearTheCutOff) {
   // The same hard shortening with motors that yield: above the cut-off they give cable
   // (the table never asks for it), so the peak tension is no higher than with holding.
-  Robot robot = superball();
-  robot.motor.cutoff_tension_n = 150.0;
-  robot.motor.hard_limit_tension_n = 300.0;
+  Robot robot = low_limit_superball();
   EpisodeOptions options;
   options.duration_s = 5.0;
   const Policy shortest = constant_policy(robot, robot.motor.min_rest_length_m);
