@@ -2,6 +2,7 @@
 #include "sim/model.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -177,9 +178,10 @@ void Model::apply_forces() {
     double tension = 0.0;
     // One-sided: a slack cable pushes nothing, and its damper cannot pull it taut.
     if (stretch > 0.0) {
-      tension = cable.stiffness_n_per_m * stretch;
-      if (damping_enabled_) tension += cable.damping_n_s_per_m * length_rate_m_per_s_[m];
-      if (tension < 0.0) tension = 0.0;
+      const double elastic = cable.stiffness_n_per_m * stretch;
+      double damping = damping_enabled_ ? cable.damping_n_s_per_m * length_rate_m_per_s_[m] : 0.0;
+      if (robot_.cable_damping_capped) damping = std::clamp(damping, -elastic, elastic);
+      tension = std::max(0.0, elastic + damping);
     }
     tension_n_[m] = tension;
     if (tension == 0.0) continue;

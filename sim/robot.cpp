@@ -126,6 +126,7 @@ void parse_cables(const Reader& r, const std::vector<int>& strut_of, Robot& robo
   const Reader defaults = r.object("cable");
   const double k_default = defaults.positive("stiffness_n_per_m", 0.0, true);
   const double c_default = defaults.non_negative("damping_n_s_per_m");
+  robot.cable_damping_capped = defaults.choice("damping_law", {"linear", "capped"}, 0) == 1;
   const int n = robot.node_count();
   const json& cables = r.array("cables");
   if (cables.empty()) r.fail("cables", "needs at least one cable");

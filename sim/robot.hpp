@@ -55,6 +55,10 @@ struct Robot {
   // cables, the ground and axial_damping_n_m_s.
   bool zero_axial_spin = false;
   double initial_rest_length_m = 0.0;
+  // cable.damping_law "capped": a cable's damping force is at most its elastic force,
+  // as in the author's NTRT (Muscle2P::calculateAndApplyForce, 2014), so a taut cable
+  // pulls with between 0 and twice k (L - L0); "linear" (default) leaves it uncapped.
+  bool cable_damping_capped = false;
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;
   double time_step_s = 0.001;

@@ -147,6 +147,40 @@ TEST(Model, EnergyConservedWithoutGravityGroundAndDamping) {
   EXPECT_LT(worst, 0.02) << "relative energy error " << worst << " of " << e0 << " J";
 }
 
+// NTRT's cable law (cable.damping_law "capped"): the damper adds at most the elastic
+// force and takes away at most all of it. A breathing structure's cables move fast
+// enough that the uncapped damper exceeds both bounds; the capped one never does.
+double worst_damping_ratio(bool capped) {
+  Robot robot = superball();
+  robot.cable_damping_capped = capped;
+  for (auto& c : robot.cables) c.damping_n_s_per_m = 200.0;
+  Model model(robot, robot.time_step_s);
+  model.set_gravity_enabled(false);
+  model.set_ground_enabled(false);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : robot.nodes_m) centre += p / 12.0;
+  for (int s = 0; s < 6; ++s) {
+    const auto& strut = robot.struts[s];
+    const Eigen::Vector3d mid = 0.5 * (robot.nodes_m[strut.node_a] + robot.nodes_m[strut.node_b]) - centre;
+    model.set_velocity(s, -2.0 * mid, Eigen::Vector3d(1.0, -0.5, 0.8));
+  }
+  const std::vector<double> hold(24, 0.7);  // taut everywhere
+  double worst = 0.0;  // largest |T - k s| / (k s) over taut cables
+  for (int i = 0; i < 500; ++i) {
+    model.step(hold);
+    for (int m = 0; m < model.cable_count(); ++m) {
+      const double elastic = robot.cables[m].stiffness_n_per_m * (model.length_m()[m] - model.rest_length_m()[m]);
+      if (elastic > 1.0) worst = std::max(worst, std::fabs(model.tension_n()[m] - elastic) / elastic);
+    }
+  }
+  return worst;
+}
+
+TEST(Model, CappedDampingStaysWithinTheElasticForce) {
+  EXPECT_GT(worst_damping_ratio(false), 1.0);
+  EXPECT_LE(worst_damping_ratio(true), 1.0 + 1e-9);
+}
+
 TEST(Model, StrutCannotWheelAboutItsOwnAxis) {
   const Robot robot = superball();
   Robot undamped = robot;

@@ -208,6 +208,22 @@ TEST(Robot, OverloadIsOptionalAndValidated) {
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.overload: must be a string"));
 }
 
+TEST(Robot, DampingLawIsOptionalAndValidated) {
+  json doc = superball_json();
+  const Robot plain = parse_robot(doc.dump(), "test.json");
+  EXPECT_FALSE(plain.cable_damping_capped);
+  doc["cable"]["damping_law"] = "capped";
+  const Robot capped = parse_robot(doc.dump(), "test.json");
+  EXPECT_TRUE(capped.cable_damping_capped);
+  EXPECT_NE(capped.hash, plain.hash);
+  doc["cable"]["damping_law"] = "linear";
+  EXPECT_FALSE(parse_robot(doc.dump(), "test.json").cable_damping_capped);
+  doc["cable"]["damping_law"] = "clipped";
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.damping_law: must be \"linear\" or \"capped\" (got \"clipped\")"));
+  doc["cable"]["damping_law"] = 0;
+  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.damping_law: must be a string"));
+}
+
 TEST(Robot, EngineAndAxialSpinAreOptionalAndValidated) {
   json doc = superball_json();
   const Robot plain = parse_robot(doc.dump(), "test.json");
