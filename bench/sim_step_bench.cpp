@@ -24,14 +24,14 @@ void step_settled(benchmark::State& state, const Robot& robot) {
   state.SetItemsProcessed(state.iterations());
 }
 
-void BM_ModelStep(benchmark::State& state) { step_settled(state, load_robot(default_robot_path())); }
+void BM_ModelStep(benchmark::State& state) { step_settled(state, load_robot(robot_path_named("superball"))); }
 BENCHMARK(BM_ModelStep);
 
 // What the strut-gap measurement adds to every step, rod contact or not
 // (sim/model_strut_contact.cpp): the closest points of the 15 strut pairs, here
 // on the settled pose, beside BM_ModelStep above.
 void BM_StrutGapMeasurement(benchmark::State& state) {
-  const Robot robot = load_robot(default_robot_path());
+  const Robot robot = load_robot(robot_path_named("superball"));
   Model model(robot, 0.001);
   model.restore(settled_state(robot, 0.001));
   std::vector<dVector3> a(robot.struts.size()), b(robot.struts.size());
@@ -62,10 +62,10 @@ BENCHMARK(BM_StrutGapMeasurement);
 
 // A step with rod contact on: the measurement plus any contact joints.
 void BM_ModelStepRodContact(benchmark::State& state) {
-  Robot robot = load_robot(default_robot_path());
+  Robot robot = load_robot(robot_path_named("superball"));
   robot.rod_contact = true;
   Model model(robot, 0.001);
-  model.restore(settled_state(load_robot(default_robot_path()), 0.001));
+  model.restore(settled_state(load_robot(robot_path_named("superball")), 0.001));
   std::vector<double> preferred(robot.cables.size(), robot.initial_rest_length_m);
   for (auto _ : state) {
     model.step(preferred);
@@ -77,7 +77,7 @@ BENCHMARK(BM_ModelStepRodContact);
 
 // The same settled robot in the Bullet engine (robot.engine "bullet").
 void BM_ModelStepBullet(benchmark::State& state) {
-  Robot robot = load_robot(default_robot_path());
+  Robot robot = load_robot(robot_path_named("superball"));
   robot.engine = Robot::PhysicsEngine::bullet;
   robot.hash += "-bullet";  // settled_state caches by hash
   step_settled(state, robot);
@@ -85,7 +85,7 @@ void BM_ModelStepBullet(benchmark::State& state) {
 BENCHMARK(BM_ModelStepBullet);
 
 void BM_BenchmarkEpisode10s(benchmark::State& state) {
-  const Robot robot = load_robot(default_robot_path());
+  const Robot robot = load_robot(robot_path_named("superball"));
   EpisodeOptions options;
   options.duration_s = 10.0;
   options.start = StartKind::drop;

@@ -91,7 +91,7 @@ void add_sim_command(CLI::App& app) {
   auto args = std::make_shared<SimArgs>();
   CLI::App* cmd = app.add_subcommand("sim", "Run one episode of the robot model and summarise it");
   cmd->add_option("--robot", args->robot,
-                  "Robot description (default: the one the policy names, else robots/superball.json)")
+                  "Robot description (default: the one the policy names, else robots/superball-paper.json)")
       ->check(CLI::ExistingFile);
   auto* policy =
       cmd->add_option("--policy", args->policy, "Policy file to play (tensegrity-policy/1)")->check(CLI::ExistingFile);

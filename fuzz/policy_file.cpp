@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a policy file ("tensegrity-policy/1") as the simulator reads it
-// (against the default robot) and as an end cap reads its share of it.
+// (against DESIGN.md's robot, which the corpus's policies are for) and as an end cap reads its share of it.
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -17,7 +17,7 @@ namespace app = tensegrity::fw::app;
 namespace {
 
 const sim::Robot& robot() {
-  static const sim::Robot r = sim::load_robot(sim::default_robot_path());
+  static const sim::Robot r = sim::load_robot(sim::robot_path_named("superball"));
   return r;
 }
 

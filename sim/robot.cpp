@@ -229,6 +229,6 @@ std::filesystem::path robot_path_named(const std::string& name) {
   return std::filesystem::path("robots") / file;
 }
 
-std::filesystem::path default_robot_path() { return robot_path_named("superball"); }
+std::filesystem::path default_robot_path() { return robot_path_named("superball-paper"); }
 
 }  // namespace tensegrity::sim

@@ -95,7 +95,8 @@ Robot load_robot(const std::filesystem::path& path);
 // robots/<name>.json, found via TENSEGRITY_ROBOTS_DIR, the source tree this binary
 // was built from, or ./robots (the path is returned even when no such file exists).
 std::filesystem::path robot_path_named(const std::string& name);
-// The shipped default: robots/superball.json (DESIGN.md's hardware).
+// The shipped default: robots/superball-paper.json, the paper's simulated SUPERball
+// (issue 14; docs/model.md). DESIGN.md's hardware is robot_path_named("superball").
 std::filesystem::path default_robot_path();
 // FNV-1a 64-bit of `text`, as 16 lower-case hex digits.
 std::string fnv1a64_hex(const std::string& text);

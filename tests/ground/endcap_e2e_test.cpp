@@ -188,7 +188,7 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
 
   // 2. Upload latency to the 12 real end caps (idle loops take a table at once):
   // the same ground::upload code, successive versions, first write to last ack.
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   const sim::Policy gait = sim::load_policy(policy, robot);
   std::vector<double> latencies_ms;
   for (std::uint32_t v = 4; v < 34; ++v) {

@@ -47,7 +47,7 @@ class GroundDds : public ::testing::Test {
     shm_before_ = shm_files();
     dir_ = fs::temp_directory_path() / ("ground_dds_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
-    robot_ = sim::load_robot(sim::default_robot_path());
+    robot_ = sim::load_robot(sim::robot_path_named("superball"));
   }
   void TearDown() override {
     nodes_.clear();

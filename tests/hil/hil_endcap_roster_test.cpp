@@ -17,7 +17,7 @@ using hil_test::FakeClock;
 using hil_test::FakeProcesses;
 
 const sim::Robot& robot() {
-  static const sim::Robot r = sim::load_robot(sim::default_robot_path());
+  static const sim::Robot r = sim::load_robot(sim::robot_path_named("superball"));
   return r;
 }
 

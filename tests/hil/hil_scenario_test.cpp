@@ -76,7 +76,7 @@ TEST(HilScenario, SupervisionFaults) {
 }
 
 TEST(HilScenario, DisabledCableFaultsItsOwnersDriveAndReleasesIt) {
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   // Cable 3 (nodes 0-10) is owned by end cap 10, whose cables are 3 and 16.
   const ScenarioEvent e = disabled_cable_event(robot, 3);
   EXPECT_EQ(e.endcap, 10);

@@ -34,7 +34,7 @@ namespace tensegrity::hil::hil_test {
 namespace fs = std::filesystem;
 
 inline const sim::Robot& robot() {
-  static const sim::Robot r = sim::load_robot(sim::default_robot_path());
+  static const sim::Robot r = sim::load_robot(sim::robot_path_named("superball"));
   return r;
 }
 

@@ -27,7 +27,7 @@ Robot with_engine(Robot robot, Robot::PhysicsEngine engine) {
   return robot;
 }
 
-Robot superball(Robot::PhysicsEngine engine) { return with_engine(load_robot(default_robot_path()), engine); }
+Robot superball(Robot::PhysicsEngine engine) { return with_engine(load_robot(robot_path_named("superball")), engine); }
 
 void run(Model& model, double seconds, std::span<const double> preferred) {
   const auto steps = static_cast<int>(std::lround(seconds / model.dt_s()));

@@ -18,7 +18,7 @@
 namespace tensegrity::sim {
 namespace {
 
-Robot superball() { return load_robot(default_robot_path()); }
+Robot superball() { return load_robot(robot_path_named("superball")); }
 
 // Records what the model did, every step.
 class Recorder final : public TelemetrySink {

@@ -17,7 +17,7 @@
 namespace tensegrity::sim {
 namespace {
 
-Robot superball() { return load_robot(default_robot_path()); }
+Robot superball() { return load_robot(robot_path_named("superball")); }
 
 void run(Model& model, double seconds, std::span<const double> preferred) {
   const auto steps = static_cast<int>(std::lround(seconds / model.dt_s()));

@@ -19,7 +19,7 @@ using ::testing::HasSubstr;
 
 class PolicyFile : public ::testing::Test {
  protected:
-  Robot robot = load_robot(default_robot_path());
+  Robot robot = load_robot(robot_path_named("superball"));
 
   json good() const {
     Policy p;

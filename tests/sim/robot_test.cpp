@@ -15,7 +15,7 @@ using nlohmann::json;
 using ::testing::HasSubstr;
 
 json superball_json() {
-  std::ifstream in(default_robot_path());
+  std::ifstream in(robot_path_named("superball"));
   std::stringstream s;
   s << in.rdbuf();
   return json::parse(s.str());
@@ -31,7 +31,7 @@ std::string error_of(const json& doc) {
 }
 
 TEST(Robot, ShippedSuperballLoads) {
-  const Robot robot = load_robot(default_robot_path());
+  const Robot robot = load_robot(robot_path_named("superball"));
   EXPECT_EQ(robot.name, "superball");
   EXPECT_EQ(robot.node_count(), 12);
   EXPECT_EQ(robot.struts.size(), 6U);
@@ -42,6 +42,20 @@ TEST(Robot, ShippedSuperballLoads) {
   for (const auto& c : robot.cables) {
     EXPECT_NEAR((robot.nodes_m[c.node_a] - robot.nodes_m[c.node_b]).norm(), 1.0408, 1e-3);
   }
+}
+
+// Issue 14: the default is the paper's simulated SUPERball (1.5 m rods, the author's
+// anchors and rod contact, DESIGN.md's cables), not DESIGN.md's 1.7 m hardware.
+TEST(Robot, TheDefaultIsThePapersSimulatedSuperball) {
+  const Robot robot = load_robot(default_robot_path());
+  EXPECT_EQ(robot.name, "superball-paper");
+  const auto& s = robot.struts[0];
+  EXPECT_NEAR((robot.nodes_m[s.node_a] - robot.nodes_m[s.node_b]).norm(), 1.5, 1e-9);
+  EXPECT_EQ(robot.cable_attachment, CableAttachment::surface);
+  EXPECT_TRUE(robot.rod_contact);
+  EXPECT_DOUBLE_EQ(robot.cables[0].stiffness_n_per_m, 1000.0);
+  EXPECT_DOUBLE_EQ(robot.cables[0].damping_n_s_per_m, 50.0);
+  EXPECT_NE(robot.hash, load_robot(robot_path_named("superball")).hash);
 }
 
 TEST(Robot, HashChangesWithContent) {

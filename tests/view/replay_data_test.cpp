@@ -17,7 +17,7 @@ namespace {
 std::filesystem::path temp(const std::string& name) { return std::filesystem::path(testing::TempDir()) / name; }
 
 TEST(ReplayData, ReadsTheSimulatorsTelemetryAtTheFrameRate) {
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   const auto path = temp("sim.csv");
   sim::BenchmarkController controller;
   sim::EpisodeOptions options;
@@ -74,7 +74,7 @@ std::string hil_row(double t, int nodes, int cables, double x) {
 }
 
 TEST(ReplayData, ReadsAHilRecordWithoutEnergy) {
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   const auto path = temp("hil.csv");
   std::ofstream(path) << hil_header(12, 24) << hil_row(0.0, 12, 24, 0.0) << hil_row(0.001, 12, 24, 0.01)
                       << hil_row(0.03, 12, 24, 3.0);
@@ -89,7 +89,7 @@ TEST(ReplayData, ReadsAHilRecordWithoutEnergy) {
 }
 
 std::string error_of(const std::filesystem::path& path) {
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   std::vector<std::string> warnings;
   try {
     load_replay_csv(path, robot, warnings);

@@ -115,7 +115,7 @@ TEST(LiveBridge, HasNoWriterAndForwardsTelemetryToThePage) {
   dds::DataWriter* impostor =
       msgs::create_writer(*peer, *impostor_publisher, msgs::kTelemetryTopic,
                           dds::TypeSupport(new tensegrity_msgs::msg::dds_::Telemetry_PubSubType()));
-  const sim::Robot robot = sim::load_robot(sim::default_robot_path());
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   EventHub hub;
   std::uint64_t cursor = hub.head();
   std::uint64_t skipped = 0;

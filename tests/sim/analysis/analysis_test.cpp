@@ -41,7 +41,7 @@ std::size_t lines_in(const std::filesystem::path& path) {
 }
 
 TEST(Analysis, AShortEpisodeGivesEveryFigureAndWritesItsFiles) {
-  const Robot robot = load_robot(default_robot_path());
+  const Robot robot = load_robot(robot_path_named("superball"));
   const Policy policy = random_policy(robot, 3);
   CoreController controller(robot, policy);
   EpisodeSeries series;

@@ -48,7 +48,7 @@ TEST(Determinism, SyntheticFitnessIsTheSameOnOneTwoAndThreeThreads) {
 }
 
 TEST(Determinism, PhysicsIsTheSameOnOneTwoAndThreeThreads) {
-  const Robot robot = load_robot(default_robot_path());
+  const Robot robot = load_robot(robot_path_named("superball"));
   EvolveConfig config;
   config.teams = 4;
   config.episodes = 8;  // 2 generations

@@ -110,7 +110,7 @@ void errors(MpiSession& session) {
 }
 
 void physics(MpiSession& session) {
-  const std::string path = default_robot_path().string();
+  const std::string path = robot_path_named("superball").string();
   const Robot robot = load_robot(path);
   EvolveConfig config;
   config.teams = 5;

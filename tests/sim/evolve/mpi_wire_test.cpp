@@ -98,7 +98,7 @@ TEST(MpiWire, DamagedBytesAreRefused) {
 }
 
 std::string robot_text() {
-  std::ifstream in(default_robot_path(), std::ios::binary);
+  std::ifstream in(robot_path_named("superball"), std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
