@@ -366,7 +366,8 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_flag("--resume", args->resume,
                 "Continue the run checkpointed in --checkpoint (a larger --episodes extends a finished run)");
   // Not checked by the parser: with --mpi only rank 0 reads it, the other machines need no copy.
-  cmd->add_option("--robot", args->robot, "Robot description (default: robots/superball-paper.json, the paper's model)");
+  cmd->add_option("--robot", args->robot,
+                  "Robot description (default: robots/superball-paper.json, the paper's model)");
   cmd->add_option("--population", args->population, "Members per cable population")
       ->capture_default_str()
       ->check(CLI::Range(2, 100000));

@@ -83,7 +83,7 @@ void add_view_command(CLI::App& app) {
                   "An evolution's checkpoint directory (tensegrity evolve --checkpoint DIR)")
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--robot", args->robot,
-                  "Robot description (tension limits, cables); default: robots/superball-paper.json, for --evolve the run's")
+                  "Robot (tension limits, cables); default: robots/superball-paper.json, for --evolve the run's")
       ->check(CLI::ExistingFile);
   cmd->add_option("--domain", args->domain, "--live: DDS domain (default: TENSEGRITY_DOMAIN, else 42)")
       ->check(CLI::Range(0, 232));

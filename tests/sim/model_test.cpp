@@ -165,7 +165,7 @@ double worst_damping_ratio(bool capped) {
     model.set_velocity(s, -2.0 * mid, Eigen::Vector3d(1.0, -0.5, 0.8));
   }
   const std::vector<double> hold(24, 0.7);  // taut everywhere
-  double worst = 0.0;  // largest |T - k s| / (k s) over taut cables
+  double worst = 0.0;                       // largest |T - k s| / (k s) over taut cables
   for (int i = 0; i < 500; ++i) {
     model.step(hold);
     for (int m = 0; m < model.cable_count(); ++m) {

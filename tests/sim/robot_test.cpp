@@ -233,7 +233,8 @@ TEST(Robot, DampingLawIsOptionalAndValidated) {
   doc["cable"]["damping_law"] = "linear";
   EXPECT_FALSE(parse_robot(doc.dump(), "test.json").cable_damping_capped);
   doc["cable"]["damping_law"] = "clipped";
-  EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.damping_law: must be \"linear\" or \"capped\" (got \"clipped\")"));
+  EXPECT_THAT(error_of(doc),
+              HasSubstr("test.json: cable.damping_law: must be \"linear\" or \"capped\" (got \"clipped\")"));
   doc["cable"]["damping_law"] = 0;
   EXPECT_THAT(error_of(doc), HasSubstr("test.json: cable.damping_law: must be a string"));
 }
