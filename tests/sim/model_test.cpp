@@ -118,20 +118,29 @@ TEST(Model, Figure4PullingCable13ChangesOthersNonUniformly) {
   EXPECT_GE(shorter, 2);
 }
 
+// Sets every strut moving toward the centre at `rate` times its distance from it,
+// plus a per-strut drift and spin: a structure that breathes and tumbles.
+template <class Drift, class Spin>
+void squeeze(Model& model, const Robot& robot, double rate, Drift drift, Spin spin) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : robot.nodes_m) centre += p / static_cast<double>(robot.nodes_m.size());
+  for (int s = 0; s < static_cast<int>(robot.struts.size()); ++s) {
+    const auto& strut = robot.struts[s];
+    const Eigen::Vector3d mid = 0.5 * (robot.nodes_m[strut.node_a] + robot.nodes_m[strut.node_b]) - centre;
+    model.set_velocity(s, -rate * mid + drift(s), spin(s));
+  }
+}
+
 TEST(Model, EnergyConservedWithoutGravityGroundAndDamping) {
   const Robot robot = superball();
   Model model(robot, robot.time_step_s);
   model.set_gravity_enabled(false);
   model.set_ground_enabled(false);
   model.set_damping_enabled(false);
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& p : robot.nodes_m) centre += p / 12.0;
   // Spin and squeeze: a breathing, tumbling structure with every cable taut.
-  for (int s = 0; s < 6; ++s) {
-    const auto& strut = robot.struts[s];
-    const Eigen::Vector3d mid = 0.5 * (robot.nodes_m[strut.node_a] + robot.nodes_m[strut.node_b]) - centre;
-    model.set_velocity(s, -0.3 * mid + Eigen::Vector3d(0.0, 0.0, 0.05 * s), Eigen::Vector3d(0.4, -0.2 + 0.1 * s, 0.3));
-  }
+  squeeze(
+      model, robot, 0.3, [](int s) { return Eigen::Vector3d(0.0, 0.0, 0.05 * s); },
+      [](int s) { return Eigen::Vector3d(0.4, -0.2 + 0.1 * s, 0.3); });
   const std::vector<double> hold(24, robot.initial_rest_length_m);
   const double e0 = model.kinetic_energy_j() + model.elastic_energy_j();
   ASSERT_GT(model.kinetic_energy_j(), 0.5);
@@ -157,13 +166,9 @@ double worst_damping_ratio(bool capped) {
   Model model(robot, robot.time_step_s);
   model.set_gravity_enabled(false);
   model.set_ground_enabled(false);
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& p : robot.nodes_m) centre += p / 12.0;
-  for (int s = 0; s < 6; ++s) {
-    const auto& strut = robot.struts[s];
-    const Eigen::Vector3d mid = 0.5 * (robot.nodes_m[strut.node_a] + robot.nodes_m[strut.node_b]) - centre;
-    model.set_velocity(s, -2.0 * mid, Eigen::Vector3d(1.0, -0.5, 0.8));
-  }
+  squeeze(
+      model, robot, 2.0, [](int) { return Eigen::Vector3d::Zero(); },
+      [](int) { return Eigen::Vector3d(1.0, -0.5, 0.8); });
   const std::vector<double> hold(24, 0.7);  // taut everywhere
   double worst = 0.0;                       // largest |T - k s| / (k s) over taut cables
   for (int i = 0; i < 500; ++i) {
