@@ -8,7 +8,7 @@
 
 namespace tensegrity::cli {
 
-inline constexpr const char* kShippedPolicy = "policies/superball-spin-held-t4-n5.json";
+inline constexpr const char* kShippedPolicy = "policies/superball-paper-t4-n5.json";
 
 // `given` when not empty, else the shipped policy; CommandError (2) when it is missing.
 std::filesystem::path shipped_policy_or(const std::string& given);

@@ -6,11 +6,11 @@
 # cap summary, and a plot (out/hil-run.png).
 # It ends by printing the command that replays the run in a browser (tensegrity view).
 #   scripts/run.sh [--evolve [--seed N]] [--duration S]
-# The robot is DESIGN.md's with its struts' spin held (robots/superball-spin-held.json);
+# The robot is the default, the paper's simulated SUPERball (robots/superball-paper.json);
 # --evolve learns with tensegrity evolve's defaults: 40 members per cable population (the
 # author's is 10) and a 0.05 m step annealed to 0.02 m over episodes 2000-5000. With them
-# 8 of seeds 1-10 learned a 37-39 m gait in 5000 episodes (docs/results.md, "anneal40");
-# seed 1 learns 38.4 m, the shipped policy to the last digit
+# 10 of seeds 1-10 learned a 33-35 m gait in 5000 episodes (docs/results.md, "The cables");
+# seed 1 learns 33.7 m, the shipped policy to the last digit
 # (tests/sim/shipped_policy_test.cpp holds the shipped file to this seed and these settings).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -37,14 +37,14 @@ bin=build/release
 tensegrity="$bin/cli/tensegrity"
 mkdir -p out
 
-policy=policies/superball-spin-held-t4-n5.json
+policy=policies/superball-paper-t4-n5.json
 if [[ $evolve -eq 1 ]]; then
   policy=out/evolved.json
   echo "== evolving a policy (t = 4 s, n = 5, historical average, population 40, step 0.05 -> 0.02 m, 5000 episodes, seed $seed)"
-  # The checkpoint is per seed and schedule: --resume must not continue another seed's
-  # run, nor one begun with session 22's constant step (it would be refused).
-  "$tensegrity" evolve --robot robots/superball-spin-held.json --period 4 --complexity 5 --method historical --episodes 5000 \
-    --population 40 --replace 20 --seed "$seed" --checkpoint "out/evolve-checkpoint-p40-anneal-s$seed" --resume \
+  # The checkpoint is per robot, seed and schedule: --resume must not continue another
+  # seed's run, nor one begun on the spin-held robot before session 29 (it would be refused).
+  "$tensegrity" evolve --robot robots/superball-paper.json --period 4 --complexity 5 --method historical --episodes 5000 \
+    --population 40 --replace 20 --seed "$seed" --checkpoint "out/evolve-checkpoint-paper-p40-anneal-s$seed" --resume \
     --out "$policy" --log out/evolve-curve.csv
 fi
 
