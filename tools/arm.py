@@ -52,7 +52,8 @@ def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="arm directory (or the comparison's, with --compare)")
     p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball-ntrt2014.json"), help="robot description")
+    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
+                   help="robot description (default: the default robot, the paper's simulated SUPERball)")
     p.add_argument("--set", action="append", default=[], metavar="PATH=JSON",
                    help="change a robot field, e.g. strut.axial_damping_n_m_s=0.05 (repeatable)")
     p.add_argument("--seeds", type=int, default=10, help="seeds per arm (default: %(default)s)")

@@ -51,7 +51,8 @@ def parse_args():
     p.add_argument("--out", default="out/experiments", help="output directory (default: %(default)s)")
     p.add_argument("--tensegrity", default=str(ROOT / "build/release/cli/tensegrity"),
                    help="the tensegrity program (default: %(default)s)")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball.json"), help="robot description")
+    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
+                   help="robot description (default: the default robot, the paper's simulated SUPERball)")
     p.add_argument("--seeds", type=int, default=5, help="seeds per configuration, 1..N (default: %(default)s)")
     p.add_argument("--method-seeds", type=int, default=None,
                    help="seeds for figure 6's leniency and average baselines (default: --seeds)")

@@ -37,7 +37,8 @@ def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball.json"), help="robot description")
+    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
+                   help="robot description (default: the default robot, the paper's simulated SUPERball)")
     p.add_argument("--set", action="append", default=[], metavar="PATH=JSON", help="change a robot field (repeatable)")
     p.add_argument("--tables", type=int, default=120, help="random tables (default: %(default)s)")
     p.add_argument("--seed", type=int, default=1, help="seed of the tables (default: %(default)s)")
