@@ -51,6 +51,7 @@ struct HilArgs {
   std::string host_loss = "continue";
   int domain = -1;
   std::string keystore;
+  int link_attempts = 3;
   bool insecure = false;
   bool secure = false;
   std::vector<int> disabled_cables;
@@ -83,6 +84,7 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
   o.host_loss = a.host_loss;
   o.dds_domain = a.domain;
+  o.link_attempts = a.link_attempts;
   // Secured unless --insecure, with --keystore DIR or the default keystore; the HIL
   // runs both ends, so it makes the keystore if there is none yet.
 #ifdef TENSEGRITY_CLI_DDS
@@ -195,6 +197,11 @@ void add_hil_command(CLI::App& app) {
       ->check(CLI::IsMember({"continue", "stop"}));
   cmd->add_option("--domain", args->domain, "dds: DDS domain of this run (default: a free one of 215..232)")
       ->check(CLI::Range(0, 232));
+  cmd->add_option("--link-attempts", args->link_attempts,
+                  "dds: start the run afresh this many times at most when the link does not come up before the "
+                  "start (Fast DDS's stalled secured handshakes; docs/security.md)")
+      ->check(CLI::Range(1, 10))
+      ->capture_default_str();
 #ifdef TENSEGRITY_CLI_DDS
   add_security_options(*cmd, args->keystore, args->insecure);
   cmd->add_flag("--secure", args->secure,

@@ -82,7 +82,7 @@ void DdsProvisioner::await_endcaps(std::uint16_t mask, std::int64_t deadline_ns)
   std::string why = within;
   if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
   if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
-  throw HilError(why + " (see their logs)");
+  throw LinkDownError(why + " (see their logs)");
 }
 
 }  // namespace tensegrity::hil

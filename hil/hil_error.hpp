@@ -13,4 +13,11 @@ class HilError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The DDS link did not come up for every end cap before the start: nothing has moved,
+// so run_hil may start every process again (HilOptions::link_attempts).
+class LinkDownError : public HilError {
+ public:
+  using HilError::HilError;
+};
+
 }  // namespace tensegrity::hil

@@ -60,6 +60,7 @@ nlohmann::json to_json(const HilResult& r) {
           {"rejoins", r.stats.rejoins},
           {"max_tension_n", r.stats.max_tension_n},
           {"provisioner", r.provisioner},
+          {"link_attempts", r.link_attempts},
           {"hold_ticks", r.stats.hold_ticks},
           {"hold_wall_s", r.stats.hold_wall_s},
           {"endcaps_playing", r.playing},
@@ -82,6 +83,9 @@ std::string summary_text(const HilResult& r) {
   std::snprintf(line, sizeof line, "provisioner %s; %d end caps playing at the end, table phases within %.3f ms\n",
                 r.provisioner.c_str(), r.playing, r.max_phase_offset_s * 1e3);
   s << line;
+  if (r.link_attempts > 1)
+    s << "link: " << r.link_attempts
+      << " attempts (the DDS link was down before the start; every process started afresh)\n";
   if (r.mode == StepperMode::realtime) {
     std::snprintf(
         line, sizeof line, "late steps %lld of %lld (%.4f%%), worst %.3f ms late\n",

@@ -84,18 +84,23 @@ std::unique_ptr<Provisioner> make_provisioner(const HilOptions& options, const s
 void start_with_hold(WorldStepper& stepper, Provisioner& provisioner, double timeout_s) {
   stepper.start();
   StartHandshake handshake;
-  std::thread worker([&provisioner, &handshake] {
+  bool link_down = false;  // the worker's, read after join
+  std::thread worker([&provisioner, &handshake, &link_down] {
     try {
       provisioner.deliver(handshake);
+    } catch (const LinkDownError& e) {
+      link_down = true;
+      handshake.fail(e.what());
     } catch (const std::exception& e) {
       handshake.fail(e.what());
     }
   });
   try {
     stepper.hold(handshake, static_cast<std::int64_t>(timeout_s * 1e9));
-  } catch (...) {
+  } catch (const std::exception& e) {
     handshake.fail("the world stepper stopped holding");  // ends a wait for the freeze
     worker.join();
+    if (link_down) throw LinkDownError(e.what());  // the stepper's words, the provisioner's kind
     throw;
   }
   worker.join();
@@ -283,13 +288,12 @@ void collect(const HilOptions& options, RunParts& parts, HilResult& result) {
   if (parts.hub) result.hub_syscalls = parts.hub->syscalls();
 }
 
-}  // namespace
-
-HilResult run_hil(const HilOptions& options) {
+// One attempt: everything built, run and shut down. `link_down`: it failed because
+// the DDS link did not come up before the start (LinkDownError), nothing moved.
+HilResult run_once(const HilOptions& options, bool& link_down) {
   HilResult result;
   result.mode = options.mode;
   result.duration_s = options.duration_s;
-  const std::int64_t t0 = monotonic_ns();
   RunParts parts;
   try {
     load_inputs(options, parts);
@@ -297,12 +301,40 @@ HilResult run_hil(const HilOptions& options) {
     assemble(options, parts);
     run_phases(options, parts, result);
     result.ok = true;
+  } catch (const LinkDownError& e) {
+    result.error = e.what();
+    link_down = true;
   } catch (const std::exception& e) {
     result.error = e.what();
   }
   collect(options, parts, result);
-  result.wall_s = static_cast<double>(monotonic_ns() - t0) * 1e-9;
   return result;
+}
+
+}  // namespace
+
+HilResult run_hil(const HilOptions& options) {
+  const std::int64_t t0 = monotonic_ns();
+  const int attempts = std::max(1, options.link_attempts);
+  HilOptions attempt_options = options;
+  std::vector<std::string> earlier;  // the failed attempts' logs, then why each failed
+  for (int attempt = 1;; ++attempt) {
+    if (options.before_attempt) options.before_attempt(attempt, attempt_options);
+    bool link_down = false;
+    HilResult result = run_once(attempt_options, link_down);
+    if (!link_down || attempt == attempts || options.stop.stop_requested()) {
+      result.log.insert(result.log.begin(), earlier.begin(), earlier.end());
+      result.link_attempts = attempt;
+      result.wall_s = static_cast<double>(monotonic_ns() - t0) * 1e-9;
+      return result;
+    }
+    earlier.insert(earlier.end(), result.log.begin(), result.log.end());
+    earlier.push_back("dds: attempt " + std::to_string(attempt) + " of " + std::to_string(attempts) +
+                      " failed before the start (" + result.error +
+                      "); every end cap and the ground station start again");
+    // Said now, not with the summary: the user would otherwise wait another attempt unaware.
+    std::fprintf(stderr, "hil: %s\n", earlier.back().c_str());
+  }
 }
 
 }  // namespace tensegrity::hil

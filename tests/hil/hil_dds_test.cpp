@@ -35,12 +35,23 @@ ScenarioEvent link_event(double time_s, FaultKind fault) {
   return e;
 }
 
+bool logged(const HilResult& r, const std::string& a, const std::string& b) {
+  for (const auto& line : r.log) {
+    if (line.find(a) != std::string::npos && line.find(b) != std::string::npos) return true;
+  }
+  return false;
+}
+
+// An end cap that never joins fails the run after the last of its fresh starts.
 TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
   HilOptions o = options(1.0, Provision::dds);
   o.endcap_extra_args[7] = {"--no-dds"};  // boots on its bus, never joins DDS
   o.dds_discovery_timeout_s = 3.0;
+  o.link_attempts = 2;
   const HilResult r = run_hil(o);
   ASSERT_FALSE(r.ok);
+  EXPECT_EQ(r.link_attempts, 2);
+  EXPECT_TRUE(logged(r, "attempt 1 of 2 failed before the start", "end cap(s) 7")) << r.error;
   // End cap 7 and only it is named as silent. Within the short 3 s another end cap
   // may also still be syncing its clock (named in a second clause, after a comma):
   // that is not what this test is about, and under ctest it happened 2 runs in 3.
@@ -50,6 +61,28 @@ TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
   const char after = at + silent.size() < r.error.size() ? r.error[at + silent.size()] : ' ';
   EXPECT_TRUE(after == ' ' || after == ',') << "another end cap named as silent: " << r.error;
   EXPECT_TRUE(child_pids().empty());
+}
+
+// Fast DDS 2.9's secured discovery now and then leaves one end cap unmatched whichever
+// ground station joins (docs/security.md); the run then starts every process afresh.
+// Here end cap 7 stays off DDS in the first attempt only.
+TEST(HilDds, ALinkThatDoesNotComeUpStartsTheRunAfresh) {
+  HilOptions o = options(1.0, Provision::dds);
+  o.link_attempts = 2;
+  std::vector<int> attempts;
+  o.before_attempt = [&attempts](int attempt, HilOptions& a) {
+    attempts.push_back(attempt);
+    a.endcap_extra_args.clear();
+    if (attempt == 1) a.endcap_extra_args[7] = {"--no-dds"};
+    a.dds_discovery_timeout_s = attempt == 1 ? 3.0 : 40.0;
+  };
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.link_attempts, 2);
+  EXPECT_EQ(attempts, (std::vector<int>{1, 2}));
+  EXPECT_EQ(r.playing, 12);
+  EXPECT_TRUE(logged(r, "attempt 1 of 2 failed before the start", "end cap(s) 7"));
+  EXPECT_TRUE(child_pids().empty()) << "the first attempt's end caps left behind";
 }
 
 // `tensegrity hil --keystore DIR`: the ground station and the twelve end caps speak
