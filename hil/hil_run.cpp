@@ -102,6 +102,10 @@ void start_with_hold(WorldStepper& stepper, Provisioner& provisioner, double tim
     worker.join();
     if (link_down) throw LinkDownError(e.what());  // the stepper's words, the provisioner's kind
     throw;
+  } catch (...) {
+    handshake.fail("the world stepper stopped holding");
+    worker.join();  // whatever was thrown, never a joinable thread destroyed
+    throw;
   }
   worker.join();
 }
