@@ -151,7 +151,9 @@ void Station::heartbeat_loop() {
     hb.format_version(msgs::kFormatVersion);
     hb.source(-1);
     hb.seq(++seq);
-    hb.time_ns(now_ns());
+    const std::int64_t now = now_ns();
+    hb.time_ns(now);
+    hb.heard_endcaps(heard(now, kHeardFreshS));
     dds_->heartbeat->write(&hb);
     lock.lock();
     stop_cv_.wait_for(lock, period, [this] { return stopping_; });
@@ -195,6 +197,17 @@ void Station::wait_for_command_acks(std::int64_t deadline_ns) {
 std::array<EndcapStatus, kEndcapCount> Station::snapshot() const {
   std::lock_guard lock(mutex_);
   return status_;
+}
+
+std::uint16_t Station::heard(std::int64_t now_ns, double fresh_s) const {
+  const auto fresh_ns = static_cast<std::int64_t>(fresh_s * 1e9);
+  std::lock_guard lock(mutex_);
+  std::uint16_t mask = 0;
+  for (int e = 0; e < kEndcapCount; ++e) {
+    const EndcapStatus& s = status_[static_cast<std::size_t>(e)];
+    if (s.seen && now_ns - s.heartbeat_host_ns <= fresh_ns) mask = static_cast<std::uint16_t>(mask | (1U << e));
+  }
+  return mask;
 }
 
 bool Station::wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const {

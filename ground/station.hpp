@@ -82,6 +82,11 @@ class Station {
   static constexpr std::size_t kMaxPendingAcks = 1024;
 
   std::array<EndcapStatus, kEndcapCount> snapshot() const;
+  // The end caps whose heartbeat arrived at most `fresh_s` before `now_ns`, as a mask.
+  // This station's own heartbeat names them (kHeardFreshS), so that an end cap that
+  // hears the host but is not heard can tell and join again.
+  std::uint16_t heard(std::int64_t now_ns, double fresh_s) const;
+  static constexpr double kHeardFreshS = 2.0;
   // True once every end cap in `mask` sent a heartbeat (and, with `synced`, says
   // its clock is synchronized); false at the deadline.
   bool wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const;

@@ -30,16 +30,7 @@ int StationKeeper::rejoins() const {
 
 std::uint16_t StationKeeper::heard(const Station& station, std::uint16_t expected, std::int64_t now_ns,
                                    double fresh_s) {
-  const auto fresh_ns = static_cast<std::int64_t>(fresh_s * 1e9);
-  const auto snapshot = station.snapshot();
-  std::uint16_t mask = 0;
-  for (int e = 0; e < kEndcapCount; ++e) {
-    const EndcapStatus& s = snapshot[static_cast<std::size_t>(e)];
-    if ((expected & (1U << e)) != 0 && s.seen && now_ns - s.heartbeat_host_ns <= fresh_ns) {
-      mask = static_cast<std::uint16_t>(mask | (1U << e));
-    }
-  }
-  return mask;
+  return static_cast<std::uint16_t>(station.heard(now_ns, fresh_s) & expected);
 }
 
 void StationKeeper::tick(std::int64_t now_ns) {

@@ -20,6 +20,7 @@ nlohmann::json to_json(const HilResult& r) {
                        {"host_returns", s.host_returns},
                        {"dds_link_cuts", s.link_cuts},
                        {"loop_stalls", s.loop_stalls},
+                       {"dds_rejoins", s.dds_rejoins},
                        {"exit_status", s.exit_status},
                        {"cpu_s", s.cpu_s},
                        {"restarts", s.restarts},
@@ -106,15 +107,18 @@ std::string summary_text(const HilResult& r) {
     } else {
       std::snprintf(phase, sizeof phase, "%8s", "-");
     }
-    std::snprintf(
-        line, sizeof line,
-        "%7d  %-20s  %s  %9llu/%-4llu  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n", e.endcap,
-        e.fault.c_str(), phase, static_cast<unsigned long long>(e.host_losses),
-        static_cast<unsigned long long>(e.host_returns), static_cast<unsigned long long>(e.overruns),
-        static_cast<unsigned long long>(e.rx_drops), static_cast<unsigned long long>(e.bus.rx_frames),
-        static_cast<unsigned long long>(e.bus.tx_frames), static_cast<unsigned long long>(e.bus.injected_drops),
-        static_cast<unsigned long long>(e.bus.injected_corrupt), static_cast<unsigned long long>(e.devices.emcy_sent),
-        e.cpu_s, drives.c_str(), e.restarts ? (" (restarted " + std::to_string(e.restarts) + "x)").c_str() : "");
+    std::snprintf(line, sizeof line,
+                  "%7d  %-20s  %s  %9llu/%-4llu  %8llu  %8llu  %6llu/%-6llu  %8llu/%-8llu  %9llu  %5.2f  %s%s\n",
+                  e.endcap, e.fault.c_str(), phase, static_cast<unsigned long long>(e.host_losses),
+                  static_cast<unsigned long long>(e.host_returns), static_cast<unsigned long long>(e.overruns),
+                  static_cast<unsigned long long>(e.rx_drops), static_cast<unsigned long long>(e.bus.rx_frames),
+                  static_cast<unsigned long long>(e.bus.tx_frames),
+                  static_cast<unsigned long long>(e.bus.injected_drops),
+                  static_cast<unsigned long long>(e.bus.injected_corrupt),
+                  static_cast<unsigned long long>(e.devices.emcy_sent), e.cpu_s, drives.c_str(),
+                  (std::string(e.restarts ? " (restarted " + std::to_string(e.restarts) + "x)" : "") +
+                   (e.dds_rejoins ? " (DDS rejoins " + std::to_string(e.dds_rejoins) + ")" : ""))
+                      .c_str());
     s << line;
   }
   return s.str();

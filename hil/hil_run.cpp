@@ -263,6 +263,7 @@ EndcapSummary summarize(const EndcapProcessReport& r, const RunParts& parts) {
   s.host_returns = link.host_returns;
   s.link_cuts = link.link_cuts;
   s.loop_stalls = link.loop_stalls;
+  s.dds_rejoins = link.rejoins;
   if (parts.hub) s.bus = parts.hub->counters(r.endcap);
   if (static_cast<std::size_t>(r.endcap) < parts.devices_at_end.size()) {
     s.devices = parts.devices_at_end[static_cast<std::size_t>(r.endcap)];

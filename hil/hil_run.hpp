@@ -91,11 +91,13 @@ struct EndcapSummary {
   bool playing = false;
   double phase_offset_s = 0.0;
   // From its stats (every incarnation): host losses seen, DDS link cuts (fault
-  // injection), loop stalls (the DDS node withheld its heartbeat).
+  // injection), loop stalls (the DDS node withheld its heartbeat), new DDS
+  // participants the end cap made because no host heard it.
   std::uint64_t host_losses = 0;
   std::uint64_t host_returns = 0;
   std::uint64_t link_cuts = 0;
   std::uint64_t loop_stalls = 0;
+  std::uint64_t dds_rejoins = 0;
 };
 
 struct HilResult {

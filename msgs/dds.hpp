@@ -21,17 +21,14 @@
 #include <string>
 #include <string_view>
 
+#include "msgs/format_version.hpp"  // kFormatVersion, every message's first field
+
 namespace tensegrity::msgs {
 
 class DdsError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-// Every message's first field. A peer with another value is refused (and logged),
-// never decoded as if it were ours. Bump on any change to an IDL file.
-// 2: time-sync request and reply carry a nonce.
-inline constexpr std::uint16_t kFormatVersion = 2;
 
 inline constexpr int kDefaultDomain = 42;
 // TENSEGRITY_DOMAIN if set (0..232, the range whose RTPS ports fit in 16 bits),

@@ -143,6 +143,7 @@ void Endcap::start_host_link() {
     node_config.expect.motor_count = config_.motor_count;
     node_config.expect.limits = config_.limits;
     node_config.host_loss = comms::parse_host_loss_action(options_.host_loss);
+    node_config.unheard_rejoin_s = options_.unheard_rejoin_s;
     if (config_.mode == LoopMode::lockstep) {
       node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
     }

@@ -41,6 +41,7 @@ struct EndcapOptions {
   double duration_s = 0.0;  // 0: until stopped
   bool no_dds = false;
   std::string host_loss = "continue";
+  double unheard_rejoin_s = 20.0;                // comms::EndcapNodeConfig::unheard_rejoin_s; 0: never
   int domain = -1;                               // -1: TENSEGRITY_DOMAIN or the default
   std::filesystem::path keystore;                // --keystore: overrides the config's dds_keystore
   bool insecure = false;                         // --insecure: DDS without security, explicitly

@@ -57,7 +57,8 @@ json to_json(const EndcapStats& s) {
        {{"host_losses", s.link.host_losses},
         {"host_returns", s.link.host_returns},
         {"link_cuts", s.link.link_cuts},
-        {"loop_stalls", s.link.loop_stalls}}},
+        {"loop_stalls", s.link.loop_stalls},
+        {"rejoins", s.link.rejoins}}},
       {"cycle", s.cycle ? timing_json(*s.cycle) : json(nullptr)},
       {"wakeup_latency", s.wakeup_latency ? timing_json(*s.wakeup_latency) : json(nullptr)},
       {"table", table},
@@ -86,7 +87,8 @@ EndcapStats parse_stats(const json& j, const std::string& source) {
   s.bring_up = f.string("bring_up", true);
   s.vm_rss_kb = static_cast<long>(f.integer("vm_rss_kb"));
   const Fields link = f.object("link");
-  s.link = {link.count("host_losses"), link.count("host_returns"), link.count("link_cuts"), link.count("loop_stalls")};
+  s.link = {link.count("host_losses"), link.count("host_returns"), link.count("link_cuts"), link.count("loop_stalls"),
+            link.count("rejoins")};
   if (!f.null_or_absent("cycle")) s.cycle = parse_timing(f.object("cycle"));
   if (!f.null_or_absent("wakeup_latency")) s.wakeup_latency = parse_timing(f.object("wakeup_latency"));
   if (!f.null_or_absent("table")) {

@@ -55,17 +55,20 @@ struct Telemetry {
 
 // What the link saw happen, counted (the log says it in words): the host's heartbeat
 // lost and back, the link cut by fault injection, the control loop seen stalled by
-// the node's watchdog. Read by the housekeeping thread for --stats-json.
+// the node's watchdog, new participants made because no host heard this end cap.
+// Read by the housekeeping thread for --stats-json.
 struct LinkEvents {
   std::uint64_t host_losses = 0;
   std::uint64_t host_returns = 0;
   std::uint64_t link_cuts = 0;
   std::uint64_t loop_stalls = 0;
+  std::uint64_t rejoins = 0;
   LinkEvents& operator+=(const LinkEvents& o) {
     host_losses += o.host_losses;
     host_returns += o.host_returns;
     link_cuts += o.link_cuts;
     loop_stalls += o.loop_stalls;
+    rejoins += o.rejoins;
     return *this;
   }
   bool operator==(const LinkEvents&) const = default;

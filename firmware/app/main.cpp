@@ -72,6 +72,11 @@ int main(int argc, char** argv) {
   cli.add_option("--host-loss", o.host_loss, "when the host's heartbeat is lost: continue the gait, or stop")
       ->check(CLI::IsMember({"continue", "stop"}))
       ->capture_default_str();
+  cli.add_option("--unheard-rejoin-s", o.unheard_rejoin_s,
+                 "hearing hosts that hear other end caps but not this one for this long, make a new DDS participant "
+                 "(a stalled security handshake; the wait doubles while unanswered, up to 8x); 0: never")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
   cli.add_option("--domain", o.domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
   std::string keystore;
   auto* keystore_opt = cli.add_option("--keystore", keystore,

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // EndcapNode: construction, the DDS entities, the node thread and the loop's side
 // of the hand-over. The work itself is in node_tables.cpp, node_commands.cpp,
-// node_status.cpp and node_time_sync.cpp.
+// node_status.cpp, node_time_sync.cpp and node_rejoin.cpp.
 #include "firmware/comms/endcap_node.hpp"
 
 #include <algorithm>
@@ -53,6 +53,20 @@ EndcapNode::~EndcapNode() { stop(); }
 
 void EndcapNode::start() {
   if (running_.load()) return;
+  dds_ = make_dds();
+  const std::int64_t now = clock_.now_ns();
+  next_telemetry_ns_ = now;
+  next_heartbeat_ns_ = now;
+  next_sync_ns_ = now;
+  next_unsynced_report_ns_ = now + kUnsyncedReportNs;
+  loop_progress_ns_ = now;
+  participant_since_ns_ = now;
+  rejoin_wait_s_ = config_.unheard_rejoin_s;
+  running_.store(true);
+  thread_ = std::thread([this] { run(); });
+}
+
+std::unique_ptr<EndcapNode::Dds> EndcapNode::make_dds() {
   auto d = std::make_unique<Dds>();
   d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id),
                                             config_.link_cut, config_.enclave_dir);
@@ -66,14 +80,14 @@ void EndcapNode::start() {
   d->telemetry = d->writer(msgs::kTelemetryTopic, dds::TypeSupport(new m::Telemetry_PubSubType()));
   d->heartbeat = d->writer(msgs::kEndcapHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()));
   d->sync_request = d->writer(msgs::kTimeSyncRequestTopic, dds::TypeSupport(new m::TimeSyncRequest_PubSubType()));
-  Dds* raw = d.get();  // `d` is moved into dds_ below; the listeners outlive that
+  Dds* raw = d.get();  // the listeners reach their own entities, never through dds_
   auto listener = [this, raw](std::function<void()> fn, const char* topic) {
     raw->listeners.push_back(std::make_unique<CallbackListener>(std::move(fn), topic, config_.endcap_id, config_.log));
     return raw->listeners.back().get();
   };
   // Readers last: a callback may fire as soon as a reader exists, and it may use
   // the writers. The two that work in the receive thread reach their reader
-  // through `raw` under its mutex, never through dds_ (not yet set here).
+  // through `raw` under its mutex.
   dds::DataReader* sync_reply =
       d->reader(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new m::TimeSyncReply_PubSubType()),
                 listener([this, raw] { on_time_sync_reply(*raw); }, msgs::kTimeSyncReplyTopic.name));
@@ -86,20 +100,12 @@ void EndcapNode::start() {
     d->sync_reply = sync_reply;
     d->command = command;
   }
-  dds_ = std::move(d);
-  const std::int64_t now = clock_.now_ns();
-  next_telemetry_ns_ = now;
-  next_heartbeat_ns_ = now;
-  next_sync_ns_ = now;
-  next_unsynced_report_ns_ = now + kUnsyncedReportNs;
-  loop_progress_ns_ = now;
-  running_.store(true);
-  // The remaining readers wake the node thread; created after dds_ is set.
-  dds_->policy = dds_->reader(msgs::kPolicyTableTopic, dds::TypeSupport(new m::PolicyTable_PubSubType()),
-                              listener([this] { wake(); }, msgs::kPolicyTableTopic.name));
-  dds_->host_heartbeat = dds_->reader(msgs::kHostHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()),
-                                      listener([this] { wake(); }, msgs::kHostHeartbeatTopic.name));
-  thread_ = std::thread([this] { run(); });
+  // These two only wake the node thread, which reads them once this object is dds_.
+  d->policy = d->reader(msgs::kPolicyTableTopic, dds::TypeSupport(new m::PolicyTable_PubSubType()),
+                        listener([this] { wake(); }, msgs::kPolicyTableTopic.name));
+  d->host_heartbeat = d->reader(msgs::kHostHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()),
+                                listener([this] { wake(); }, msgs::kHostHeartbeatTopic.name));
+  return d;
 }
 
 void EndcapNode::stop() noexcept {
@@ -161,7 +167,8 @@ void EndcapNode::run() {
   while (running_.load()) {
     const std::int64_t now = clock_.now_ns();
     service(now);
-    std::int64_t next = std::min({next_telemetry_ns_, next_heartbeat_ns_, next_sync_ns_});
+    std::int64_t next =
+        dds_ != nullptr ? std::min({next_telemetry_ns_, next_heartbeat_ns_, next_sync_ns_}) : next_remake_ns_;
     // The loop takes a table within a cycle or two: look again soon, the ack waits on it.
     if (in_flight_.active && !in_flight_.answered) next = std::min(next, now + 1'000'000);
     const std::int64_t wait_ns = std::max<std::int64_t>(0, next - clock_.now_ns());
@@ -178,9 +185,13 @@ void EndcapNode::service(std::int64_t now) {
     last_telemetry_ = t;
     loop_seen_ = true;
   }
-  handle_host_heartbeats(now);
-  handle_tables(now);
+  if (dds_ != nullptr) {
+    handle_host_heartbeats(now);
+    handle_tables(now);
+  }
   check_host_loss(now);
+  check_heard(now);             // may replace the participant (node_rejoin.cpp)
+  if (dds_ == nullptr) return;  // a rejoin could not make one: tried again shortly
   if (now >= next_telemetry_ns_) {
     send_telemetry();
     next_telemetry_ns_ += period_ns(config_.telemetry_rate_hz);

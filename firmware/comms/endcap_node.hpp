@@ -7,8 +7,9 @@
 //
 // Threads and files:
 // - the node thread (endcap_node.cpp: service) runs policy tables
-//   (node_tables.cpp), telemetry, heartbeats and host loss (node_status.cpp) and
-//   time-sync requests (node_time_sync.cpp);
+//   (node_tables.cpp), telemetry, heartbeats and host loss (node_status.cpp),
+//   time-sync requests (node_time_sync.cpp) and, when no host hears this end cap
+//   while it hears them, a new participant (node_rejoin.cpp);
 // - Fast DDS's receive thread runs commands (node_commands.cpp: an emergency stop
 //   is latched there, never waiting behind a table being stored) and time-sync
 //   replies.
@@ -71,6 +72,7 @@ class EndcapNode final : public app::HostLink {
   ClockSample clock_sample() const;
   bool clock_synced() const;
   bool host_lost() const { return host_lost_.load(); }
+  std::uint64_t rejoins() const { return rejoins_.load(std::memory_order_relaxed); }
   TimeSyncCounters time_sync_counters() const;
 
  private:
@@ -98,6 +100,7 @@ class EndcapNode final : public app::HostLink {
   };
 
   // endcap_node.cpp: the node thread.
+  std::unique_ptr<Dds> make_dds();  // throws msgs::DdsError
   void run();
   void service(std::int64_t now_ns);
   void wake();
@@ -119,6 +122,10 @@ class EndcapNode final : public app::HostLink {
   void send_telemetry();
   void send_heartbeat(std::int64_t now_ns);
   void report_link_cut();
+  // node_rejoin.cpp
+  void note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now_ns);
+  void check_heard(std::int64_t now_ns);
+  void rejoin(std::int64_t now_ns);
   // node_time_sync.cpp
   void send_time_sync_request();
   void report_if_unsynced();
@@ -152,6 +159,14 @@ class EndcapNode final : public app::HostLink {
   bool have_active_table_ = false;
   std::int64_t last_host_heartbeat_ns_ = 0;
   bool host_seen_ = false;
+  // Whether any host hears this end cap (node_rejoin.cpp), node clock.
+  std::int64_t hearing_since_ns_ = 0;       // host heartbeats arriving without a loss since
+  std::int64_t named_ns_ = 0;               // a host heartbeat last named this end cap
+  std::int64_t others_named_ns_ = 0;        // ... named another end cap
+  std::int64_t others_named_since_ns_ = 0;  // ... and had, without a gap, since
+  std::int64_t participant_since_ns_ = 0;   // this participant was made
+  std::int64_t next_remake_ns_ = 0;         // no participant (making one failed): next try
+  double rejoin_wait_s_ = 0.0;              // doubles while rejoins go unanswered
   std::uint32_t telemetry_sequence_ = 0;
   std::uint32_t heartbeat_sequence_ = 0;
   std::uint32_t sync_sequence_ = 0;
@@ -178,7 +193,7 @@ class EndcapNode final : public app::HostLink {
   TimeSyncClient sync_;
   std::atomic<bool> host_lost_{false};
   // What the log says in words, counted (written by the node thread only).
-  std::atomic<std::uint64_t> host_losses_{0}, host_returns_{0}, link_cuts_{0}, loop_stalls_{0};
+  std::atomic<std::uint64_t> host_losses_{0}, host_returns_{0}, link_cuts_{0}, loop_stalls_{0}, rejoins_{0};
 
   std::mutex wake_mutex_;
   std::condition_variable wake_cv_;

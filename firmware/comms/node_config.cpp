@@ -34,6 +34,11 @@ void validate(const EndcapNodeConfig& c) {
   positive(c.loop_ack_timeout_s, "loop_ack_timeout_s", 60.0);
   positive(c.command_max_age_s, "command_max_age_s", 3600.0);
   positive(c.loop_stall_timeout_s, "loop_stall_timeout_s", 60.0);
+  // A host names the end caps it heard in the last 2 s: a shorter wait would churn.
+  const double r = c.unheard_rejoin_s;
+  if (!(r == 0.0 || (std::isfinite(r) && r >= 3.0 && r <= 3600.0))) {
+    throw std::invalid_argument("unheard_rejoin_s = " + std::to_string(r) + ": expected 0 (never) or 3..3600");
+  }
   if (c.start_grid_ns < 0) {
     throw std::invalid_argument("start_grid_ns = " + std::to_string(c.start_grid_ns) + ": expected >= 0");
   }

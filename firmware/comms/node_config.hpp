@@ -29,6 +29,11 @@ struct EndcapNodeConfig {
   // No host heartbeat for this long (after one was seen) is a lost host.
   double host_timeout_s = 1.0;
   HostLossAction host_loss = HostLossAction::continue_gait;
+  // Hearing hosts that hear other end caps but have not named this one for this
+  // long, the node makes a new participant: a stalled security handshake in one
+  // direction outlives any number of fresh hosts (docs/security.md). The wait
+  // doubles after each rejoin that is not answered, up to 8 times. 0: never.
+  double unheard_rejoin_s = 20.0;
   double loop_ack_timeout_s = 2.0;
   // A start issued longer ago than this (host time) is refused as stale: it would
   // start in the wrong phase. Only starts are judged by a clock (command_gate.hpp).

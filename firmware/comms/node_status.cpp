@@ -25,6 +25,7 @@ void EndcapNode::handle_host_heartbeats(std::int64_t now) {
       }
       continue;
     }
+    note_host_heartbeat(hb.heard_endcaps(), now);
     last_host_heartbeat_ns_ = now;
     host_seen_ = true;
   }
@@ -73,7 +74,8 @@ bool EndcapNode::loop_alive(std::int64_t now) {
 
 app::LinkEvents EndcapNode::link_events() const noexcept {
   return {host_losses_.load(std::memory_order_relaxed), host_returns_.load(std::memory_order_relaxed),
-          link_cuts_.load(std::memory_order_relaxed), loop_stalls_.load(std::memory_order_relaxed)};
+          link_cuts_.load(std::memory_order_relaxed), loop_stalls_.load(std::memory_order_relaxed),
+          rejoins_.load(std::memory_order_relaxed)};
 }
 
 void EndcapNode::send_telemetry() {

@@ -95,6 +95,8 @@ int main(int argc, char** argv) {
         base.host_loss = fw::comms::parse_host_loss_action(value());
       else if (arg == "--stop-on-host-loss")
         stop_set = parse_set(value());
+      else if (arg == "--unheard-rejoin-s")
+        base.unheard_rejoin_s = std::stod(value());
       else if (arg == "--host-timeout-s")
         base.host_timeout_s = std::stod(value());
       else if (arg == "--clock-offset-spread-s")

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "firmware/hal/crc32.hpp"
+#include "msgs/format_version.hpp"
 
 namespace tensegrity::interop {
 namespace {
@@ -70,7 +71,7 @@ std::uint32_t policy_checksum(const PolicyTableC& msg) {
 
 PolicyTableOut::PolicyTableOut(const PolicyParams& p, int endcap, std::uint32_t upload_sequence) {
   validate(p);
-  msg_.format_version = 2;  // msgs::kFormatVersion
+  msg_.format_version = msgs::kFormatVersion;
   msg_.upload_sequence = upload_sequence;
   msg_.target_endcap = static_cast<std::int16_t>(endcap);
   msg_.endcap_id = static_cast<std::int16_t>(endcap);

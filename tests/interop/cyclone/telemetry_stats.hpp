@@ -9,12 +9,13 @@
 #include <cstdint>
 #include <string>
 
+#include "msgs/format_version.hpp"
 #include "tests/interop/cyclone/cyclone_link.hpp"
 
 namespace tensegrity::interop {
 
 inline constexpr int kEndcapCount = 12;
-inline constexpr std::uint16_t kFormatVersion = 2;  // msgs::kFormatVersion
+using msgs::kFormatVersion;
 
 struct EndcapTelemetry {
   bool seen = false;

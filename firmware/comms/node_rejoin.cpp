@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+// The end cap's side of a stalled link. Fast DDS 2.9's security handshake now and
+// then stalls for good in one direction (docs/security.md): an end cap then hears
+// the host's heartbeat while the host never hears its own, and no new host
+// participant clears it. The host's heartbeat names the end caps it hears; an end
+// cap that hears hosts which hear other end caps but not itself, for
+// unheard_rejoin_s, makes a new participant, as the host's stations do on their
+// side (ground/station_keeper.hpp). A host that hears nobody is left to mend its
+// own side: the fault is then not this end cap's to fix, and a one-shot tool that
+// has not heard anyone yet must not make twelve end caps churn.
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node_dds.hpp"
+
+namespace tensegrity::fw::comms {
+
+namespace {
+constexpr double kMaxBackoff = 8.0;                     // the wait grows to at most 8 x unheard_rejoin_s
+constexpr std::int64_t kOthersFreshNs = 2'000'000'000;  // "the host hears other end caps" means now
+constexpr std::int64_t kRemakeRetryNs = 1'000'000'000;  // making a participant failed: try again after
+std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
+}  // namespace
+
+void EndcapNode::note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now) {
+  // A host heard again after a loss (or for the first time) gets a full wait to hear us.
+  if (!host_seen_ || host_lost_.load()) hearing_since_ns_ = now;
+  if ((heard_endcaps & (1U << config_.endcap_id)) != 0) {
+    if (named_ns_ < participant_since_ns_) rejoin_wait_s_ = config_.unheard_rejoin_s;  // a rejoin answered
+    named_ns_ = now;
+  }
+  // The evidence against this end cap starts when hosts begin to hear others.
+  if ((heard_endcaps & ~(1U << config_.endcap_id)) != 0) {
+    if (now - others_named_ns_ > kOthersFreshNs) others_named_since_ns_ = now;
+    others_named_ns_ = now;
+  }
+}
+
+void EndcapNode::check_heard(std::int64_t now) {
+  if (dds_ == nullptr) {
+    if (now >= next_remake_ns_) rejoin(now);
+    return;
+  }
+  if (config_.unheard_rejoin_s == 0.0 || !host_seen_ || host_lost_.load()) return;
+  if (now - others_named_ns_ > kOthersFreshNs) return;
+  const std::int64_t since = std::max({named_ns_, hearing_since_ns_, others_named_since_ns_, participant_since_ns_});
+  if (now - since < to_ns(rejoin_wait_s_)) return;
+  log("hearing the host, which hears other end caps, but not heard by it for %.0f s: a new DDS participant "
+      "(rejoin %llu)",
+      static_cast<double>(now - since) * 1e-9,
+      static_cast<unsigned long long>(rejoins_.load(std::memory_order_relaxed) + 1));
+  rejoin_wait_s_ = std::min(2.0 * rejoin_wait_s_, kMaxBackoff * config_.unheard_rejoin_s);
+  rejoin(now);
+}
+
+// On the node thread, the only one that uses dds_: the old participant is closed
+// first (its listeners finish and are refused from then on), so the command gate
+// never sees two participants' receive threads at once.
+void EndcapNode::rejoin(std::int64_t now) {
+  if (dds_ != nullptr) {
+    dds_->close();
+    dds_.reset();
+    rejoins_.fetch_add(1, std::memory_order_relaxed);
+  }
+  try {
+    dds_ = make_dds();
+  } catch (const std::exception& e) {
+    log("cannot make a DDS participant: %s; trying again in %.0f s", e.what(), kRemakeRetryNs * 1e-9);
+    next_remake_ns_ = now + kRemakeRetryNs;
+    return;
+  }
+  participant_since_ns_ = now;
+  // Send at once on the new participant; a table half way to the loop is acked from it.
+  next_telemetry_ns_ = next_heartbeat_ns_ = next_sync_ns_ = now;
+}
+
+}  // namespace tensegrity::fw::comms

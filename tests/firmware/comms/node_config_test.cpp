@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "firmware/comms/node_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace tensegrity::fw::comms {
+namespace {
+
+std::string error_of(double unheard_rejoin_s) {
+  EndcapNodeConfig c;
+  c.unheard_rejoin_s = unheard_rejoin_s;
+  try {
+    validate(c);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(NodeConfig, TheUnheardRejoinWaitIsZeroOrLongerThanTheHostsHearingWindow) {
+  EXPECT_EQ(error_of(0.0), "");  // never
+  EXPECT_EQ(error_of(3.0), "");
+  EXPECT_EQ(error_of(20.0), "");
+  EXPECT_EQ(error_of(3600.0), "");
+  // Shorter than a host's 2 s window plus a heartbeat would churn; negative, too long
+  // or not a number is a typo.
+  for (const double bad : {-1.0, 1.0, 2.9, 3601.0, std::nan(""), static_cast<double>(INFINITY)}) {
+    const std::string e = error_of(bad);
+    EXPECT_NE(e.find("unheard_rejoin_s"), std::string::npos) << bad << ": " << e;
+    EXPECT_NE(e.find("0 (never) or 3..3600"), std::string::npos) << bad << ": " << e;
+  }
+}
+
+TEST(NodeConfig, TheDefaultsAreValid) { EXPECT_NO_THROW(validate(EndcapNodeConfig{})); }
+
+}  // namespace
+}  // namespace tensegrity::fw::comms

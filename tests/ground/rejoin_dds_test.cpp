@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: Apache-2.0
+// The end cap's side of a stalled link (firmware/comms/node_rejoin.cpp), with a real
+// end-cap node (comms_test_node, end cap 3) and hosts in this process. A stalled
+// security handshake cannot be made to order, so its symptom is forged: a host whose
+// heartbeat names other end caps but never this one. Such a host makes the end cap
+// join again, and the new participant is heard and obeys an emergency stop (also
+// secured: it authenticates afresh); a host that hears nobody, or a second host that
+// hears the end cap, makes it stay.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "ground/command.hpp"
+#include "ground/keystore.hpp"
+#include "ground/station.hpp"
+#include "msgs/dds.hpp"
+#include "msgs/security.hpp"
+#include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
+#include "tests/ground/subprocess.hpp"
+
+namespace tensegrity::ground {
+namespace {
+
+namespace fs = std::filesystem;
+namespace dds = eprosima::fastdds::dds;
+using test::Subprocess;
+
+constexpr int kEndcap = 3;
+constexpr double kRejoinS = 3.0;  // the smallest wait the node accepts
+constexpr const char* kRejoinLine = "a new DDS participant";
+
+// A host that publishes its heartbeat at 5 Hz naming the end caps in `names`,
+// whatever it hears: the forged symptom of a handshake stalled in one direction.
+class NamingHost {
+ public:
+  NamingHost(int domain, std::uint16_t names, const fs::path& enclave_dir = {}) : names_(names) {
+    participant_ = msgs::create_participant(domain, "naming_host", nullptr, enclave_dir);
+    auto* pub = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    writer_ = msgs::create_writer(*participant_, *pub, msgs::kHostHeartbeatTopic,
+                                  dds::TypeSupport(new msg::Heartbeat_PubSubType()));
+    thread_ = std::thread([this] {
+      for (std::uint32_t seq = 1; !stop_.load(); ++seq) {
+        msg::Heartbeat_ hb;
+        hb.format_version(msgs::kFormatVersion);
+        hb.source(-1);
+        hb.seq(seq);
+        hb.time_ns(Station::now_ns());
+        hb.heard_endcaps(names_.load());
+        writer_->write(&hb);
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+    });
+  }
+  ~NamingHost() {
+    stop_.store(true);
+    thread_.join();
+    msgs::delete_participant(participant_);
+  }
+  void name(std::uint16_t names) { names_.store(names); }
+
+ private:
+  std::atomic<std::uint16_t> names_;
+  std::atomic<bool> stop_{false};
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::DataWriter* writer_ = nullptr;
+  std::thread thread_;
+};
+
+class EndcapRejoin : public ::testing::Test {
+ public:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("endcap_rejoin_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    node_.reset();
+    fs::remove_all(dir_);
+  }
+  void start_node(int domain, const fs::path& keystore = {}) {
+    std::vector<std::string> argv{COMMS_TEST_NODE,         "--domain",           std::to_string(domain),  "--endcaps",
+                                  std::to_string(kEndcap), "--unheard-rejoin-s", std::to_string(kRejoinS)};
+    if (!keystore.empty()) argv.insert(argv.end(), {"--keystore", keystore.string()});
+    node_ = std::make_unique<Subprocess>(argv, dir_ / "node.out", dir_ / "node.err");
+    ASSERT_TRUE(node_->wait_for_output("READY", std::chrono::seconds(30)));
+  }
+  std::string log() const {
+    std::ifstream in(dir_ / "node.err");
+    return {std::istreambuf_iterator<char>(in), {}};
+  }
+  int rejoins() const {
+    const std::string text = log();
+    int n = 0;
+    for (auto at = text.find(kRejoinLine); at != std::string::npos; at = text.find(kRejoinLine, at + 1)) ++n;
+    return n;
+  }
+  bool wait_for_rejoins(int n, std::chrono::seconds timeout) const {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (rejoins() < n) {
+      if (std::chrono::steady_clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return true;
+  }
+
+  fs::path dir_;
+  std::unique_ptr<Subprocess> node_;
+};
+
+constexpr std::uint16_t kOthers = kAllEndcaps & ~(1U << kEndcap);
+
+// Both tests below: a host that hears others but not end cap 3 makes it join again,
+// after the wait and then after twice the wait; a station beside it then hears the new
+// participant (which no longer rejoins) and its emergency stop lands.
+void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore) {
+  auto enclave = [&](msgs::Role role, int id) {
+    return keystore.empty() ? fs::path() : msgs::enclave_dir(keystore, msgs::enclave_name(role, id));
+  };
+  t.start_node(domain, keystore);
+  const auto t0 = std::chrono::steady_clock::now();
+  NamingHost deaf(domain, kOthers, enclave(msgs::Role::ground, -1));
+  ASSERT_TRUE(t.wait_for_rejoins(1, std::chrono::seconds(40))) << t.log();
+  // Not before the wait: the end cap gave the host kRejoinS to hear it.
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), kRejoinS - 0.3);
+  EXPECT_NE(t.log().find("rejoin 1"), std::string::npos) << t.log();
+
+  // Unanswered, it joins again after twice the wait (not in a tight loop).
+  const auto t1 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(t.wait_for_rejoins(2, std::chrono::seconds(40))) << t.log();
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 2 * kRejoinS - 0.5);
+
+  // A real station beside the deaf host hears the new participant and names it: no
+  // more rejoins, and an emergency stop lands on it.
+  StationOptions o;
+  o.domain = domain;
+  o.name = "rejoin_test_station";
+  o.enclave_dir = enclave(msgs::Role::ground, -1);
+  Station station(o);
+  ASSERT_TRUE(station.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
+  CommandOptions c;
+  c.endcap_mask = 1U << kEndcap;
+  c.retry_interval_s = kEstopRetryIntervalS;
+  const CommandReport estop = send_command(station, CommandKind::emergency_stop, 0, c);
+  EXPECT_TRUE(estop.all_accepted()) << t.log();
+  const int after = t.rejoins();
+  std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
+  EXPECT_EQ(t.rejoins(), after) << t.log();
+}
+
+TEST_F(EndcapRejoin, AnEndcapNoHostHearsJoinsAgainAndItsNewParticipantObeys) { joins_again_and_obeys(*this, 189, {}); }
+
+TEST_F(EndcapRejoin, ASecuredEndcapJoinsAgainAndAuthenticatesAfresh) {
+  create_keystore(dir_ / "keystore");
+  joins_again_and_obeys(*this, 193, dir_ / "keystore");
+}
+
+TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsParticipant) {
+  constexpr int kDomain = 191;
+  start_node(kDomain);
+  const auto wait = std::chrono::duration<double>(2.5 * kRejoinS);
+  // A host that hears no end cap (a tool just started, or a host whose own side is
+  // stalled) is no evidence against this end cap.
+  NamingHost fresh(kDomain, 0);
+  std::this_thread::sleep_for(wait);
+  EXPECT_EQ(rejoins(), 0) << log();
+  // One host naming it is enough, whatever the others say.
+  NamingHost hearing(kDomain, kAllEndcaps);
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // discovered
+  fresh.name(kOthers);
+  std::this_thread::sleep_for(wait);
+  EXPECT_EQ(rejoins(), 0) << log();
+  // The control: without it, the same deaf host makes the end cap join again.
+  hearing.name(kOthers);
+  EXPECT_TRUE(wait_for_rejoins(1, std::chrono::seconds(20))) << log();
+}
+
+}  // namespace
+}  // namespace tensegrity::ground
