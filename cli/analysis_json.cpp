@@ -92,6 +92,7 @@ json rolling_json(const an::Analysis& a) {
           {"faces_closed", closed},
           {"faces_per_cycle", a.cycle.faces},
           {"face_cycle_match", a.cycle.match},
+          {"face_cycle_from_s", a.cycle.faces > 0 ? nlohmann::json(a.cycle.from_s) : nlohmann::json(nullptr)},
           {"revolutions", a.turning.revolutions()},
           {"turned_total_rad", a.turning.total_angle_rad},
           {"slip_m_per_s",
@@ -140,9 +141,11 @@ void print_analysis_summary(const json& j) {
   std::printf("  power per muscle mean %.2f W (muscles %.2f-%.2f W; 1 s mean %.2f-%.2f W)\n", p["mean"].get<double>(),
               p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(), p["mean_over_1s_min"].get<double>(),
               p["mean_over_1s_max"].get<double>());
-  std::printf("  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle), %.2f s from rotation\n",
+  const auto& from = r["face_cycle_from_s"];
+  std::printf("  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle, from %.1f s), %.2f s from "
+              "rotation\n",
               period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
-              period["rotation"].get<double>());
+              from.is_null() ? 0.0 : from.get<double>(), period["rotation"].get<double>());
   std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
               r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(),
               r["face_sequence"].size(), r["slip_m_per_s"]["median"].get<double>());

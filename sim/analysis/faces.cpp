@@ -55,20 +55,38 @@ std::vector<GroundFace> face_sequence(const std::vector<double>& time_s, const C
   return out;
 }
 
-FaceCycle face_cycle(const std::vector<GroundFace>& faces, double min_match) {
+namespace {
+// How well faces[from..] repeats with a cycle of `len` faces.
+FaceCycle cycle_stats(const std::vector<GroundFace>& faces, int from, int len) {
   const int n = static_cast<int>(faces.size());
-  for (int len = 2; 2 * len <= n; ++len) {
-    int same = 0;
-    double span = 0.0;
-    for (int i = 0; i + len < n; ++i) {
-      const auto& a = faces[static_cast<std::size_t>(i)];
-      const auto& b = faces[static_cast<std::size_t>(i + len)];
-      if (a.nodes != b.nodes) continue;
-      ++same;
-      span += b.start_s - a.start_s;
+  int same = 0;
+  double span = 0.0;
+  for (int i = from; i + len < n; ++i) {
+    const auto& a = faces[static_cast<std::size_t>(i)];
+    const auto& b = faces[static_cast<std::size_t>(i + len)];
+    if (a.nodes != b.nodes) continue;
+    ++same;
+    span += b.start_s - a.start_s;
+  }
+  const double match = static_cast<double>(same) / static_cast<double>(n - from - len);
+  return {len, same > 0 ? span / same : 0.0, match, from, faces[static_cast<std::size_t>(from)].start_s};
+}
+}  // namespace
+
+FaceCycle face_cycle(const std::vector<GroundFace>& faces, double min_match, double max_settle_share) {
+  const int n = static_cast<int>(faces.size());
+  const auto last_start = static_cast<int>(max_settle_share * static_cast<double>(n));
+  for (int from = 0; from <= last_start; ++from) {
+    for (int len = 2; from + 2 * len <= n; ++len) {
+      if (cycle_stats(faces, from, len).match < min_match) continue;
+      // Settled from the first face that the next cycle repeats.
+      int settled = from;
+      while (settled + 2 * len < n &&
+             faces[static_cast<std::size_t>(settled)].nodes != faces[static_cast<std::size_t>(settled + len)].nodes) {
+        ++settled;
+      }
+      return cycle_stats(faces, settled, len);
     }
-    const double match = static_cast<double>(same) / static_cast<double>(n - len);
-    if (match >= min_match) return {len, span / same, match};
   }
   return {};
 }

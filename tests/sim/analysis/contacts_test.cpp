@@ -97,9 +97,28 @@ TEST(Faces, ARepeatingSequenceGivesItsCycleAndPeriod) {
   EXPECT_EQ(cycle.faces, 3);
   EXPECT_NEAR(cycle.period_s, 7.5, 1e-9);
   EXPECT_NEAR(cycle.match, 1.0, 1e-12);
+  EXPECT_EQ(cycle.from_face, 0);
   faces.resize(5);
   faces[3].nodes = {7, 8, 9};  // no repeat: 1 of 2 and 0 of 1 match
   EXPECT_EQ(face_cycle(faces).faces, 0);
+}
+
+TEST(Faces, TheCycleIsJudgedFromWhereTheGaitSettles) {
+  // Four faces of a start-up that never come back, then a 3-face band nine times.
+  std::vector<GroundFace> faces;
+  for (int i = 0; i < 4; ++i) faces.push_back({{10 + i, 20 + i, 30 + i}, 1.0 * i, 1.0 * i + 0.5, false});
+  const std::array<std::array<int, 3>, 3> band{{{0, 1, 2}, {1, 2, 3}, {2, 3, 4}}};
+  for (int i = 0; i < 27; ++i) faces.push_back({band[i % 3], 4.0 + 2.0 * i, 5.0 + 2.0 * i, false});
+  const FaceCycle settled = face_cycle(faces);
+  EXPECT_EQ(settled.faces, 3);
+  EXPECT_EQ(settled.from_face, 4);
+  EXPECT_NEAR(settled.from_s, 4.0, 1e-12);
+  EXPECT_NEAR(settled.period_s, 6.0, 1e-9);
+  EXPECT_NEAR(settled.match, 1.0, 1e-12);
+  // Over the whole sequence the start-up costs 4 of 28 visits: no cycle at 0.9 when
+  // the gait may not settle first.
+  EXPECT_EQ(face_cycle(faces, 0.9, 0.0).faces, 0);
+  EXPECT_EQ(face_cycle(faces, 0.9).from_face, 4);
 }
 
 }  // namespace
