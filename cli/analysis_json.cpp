@@ -142,10 +142,11 @@ void print_analysis_summary(const json& j) {
               p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(), p["mean_over_1s_min"].get<double>(),
               p["mean_over_1s_max"].get<double>());
   const auto& from = r["face_cycle_from_s"];
-  std::printf("  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle, from %.1f s), %.2f s from "
-              "rotation\n",
-              period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
-              from.is_null() ? 0.0 : from.get<double>(), period["rotation"].get<double>());
+  std::printf(
+      "  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle, from %.1f s), %.2f s from "
+      "rotation\n",
+      period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
+      from.is_null() ? 0.0 : from.get<double>(), period["rotation"].get<double>());
   std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
               r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(),
               r["face_sequence"].size(), r["slip_m_per_s"]["median"].get<double>());
