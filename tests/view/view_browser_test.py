@@ -23,7 +23,9 @@ from browser_support import (Process, check_scene, chromium, free_port, http, sc
                              wait_for_server)
 
 NTRT_ROBOT = "robots/superball-ntrt2014.json"
-POLICY = "policies/superball-ntrt2014-t4-n5-e5000.json"
+# The replay (and the README's picture of it) is the main job's: scripts/run.sh's gait.
+ROBOT = "robots/superball-paper.json"
+POLICY = "policies/superball-paper-t4-n5.json"
 
 
 def check_read_only(port, paths):
@@ -42,7 +44,7 @@ def check_bad_csv(args, good_csv, tmp):
     bad = os.path.join(tmp, "bad.csv")
     with open(bad, "w") as f:
         f.write("\n".join(lines) + "\n")
-    r = subprocess.run([args.tensegrity, "view", bad, "--robot", NTRT_ROBOT, "--port", "0"], capture_output=True,
+    r = subprocess.run([args.tensegrity, "view", bad, "--robot", ROBOT, "--port", "0"], capture_output=True,
                        text=True, timeout=60)
     name = lines[0].split(",")[3]
     assert r.returncode == 2 and f"bad.csv:5:4 ({name})" in r.stderr, f"bad CSV: {r.returncode} {r.stderr!r}"
@@ -60,7 +62,7 @@ def test_replay(args, driver, tmp):
                     "--telemetry-every", "10"], check=True, stdout=subprocess.DEVNULL, timeout=600)
     check_bad_csv(args, csv, tmp)
     port = free_port()
-    with Process([args.tensegrity, "view", csv, "--robot", NTRT_ROBOT, "--port", str(port)],
+    with Process([args.tensegrity, "view", csv, "--robot", ROBOT, "--port", str(port)],
                  os.path.join(tmp, "view.log")) as view:
         wait_for_server(port, view)
         check_read_only(port, ["/", "/api/replay", "/api/mode"])
