@@ -10,6 +10,14 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
 
 
+def format_version():
+    """msgs::kFormatVersion, read from its header: a seed with another version is
+    refused at the first check, and the search would start behind it."""
+    import re
+    text = (ROOT / "msgs" / "format_version.hpp").read_text()
+    return int(re.search(r"kFormatVersion = (\d+);", text).group(1))
+
+
 def out(target, name, data):
     d = HERE / "corpus" / target
     d.mkdir(parents=True, exist_ok=True)
@@ -77,7 +85,7 @@ class Cdr:
 
 def policy_table(endcap, values, motors=2, complexity=5, version=1, force=False, seq=1):
     c = Cdr()
-    c.u16(1); c.u32(seq); c.i16(endcap); c.i16(endcap)
+    c.u16(format_version()); c.u32(seq); c.i16(endcap); c.i16(endcap)
     c.string("superball-t4-n5"); c.u32(version); c.u8(1 if force else 0); c.string("superball")
     c.f64(4.0); c.f64(0.0); c.u32(motors); c.u32(complexity)
     c.u32(len(values))
@@ -89,7 +97,7 @@ def policy_table(endcap, values, motors=2, complexity=5, version=1, force=False,
 
 def command(kind, seq=1, mask=0xFFF, start=0, issued=1_000_000_000):
     c = Cdr()
-    c.u16(1); c.u32(seq); c.u8(kind); c.u16(mask); c.i64(start); c.i64(issued)
+    c.u16(format_version()); c.u32(seq); c.u8(kind); c.u16(mask); c.i64(start); c.i64(issued)
     return c.payload()
 
 
