@@ -14,6 +14,7 @@
 
 #include "firmware/comms/endcap_node.hpp"
 #include "firmware/comms/node_dds.hpp"
+#include "msgs/security.hpp"
 
 namespace tensegrity::fw::comms {
 
@@ -21,10 +22,12 @@ namespace {
 constexpr double kMaxBackoff = 8.0;                     // the wait grows to at most 8 x unheard_rejoin_s
 constexpr std::int64_t kOthersFreshNs = 2'000'000'000;  // "the host hears other end caps" means now
 constexpr std::int64_t kRemakeRetryNs = 1'000'000'000;  // making a participant failed: try again after
+constexpr std::uint16_t kRobotsEndcaps = (1U << msgs::kMaxEndcaps) - 1;
 std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
 }  // namespace
 
 void EndcapNode::note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now) {
+  heard_endcaps &= kRobotsEndcaps;  // bits of end caps the robot does not have mean nothing
   // A host heard again after a loss (or for the first time) gets a full wait to hear us.
   if (!host_seen_ || host_lost_.load()) hearing_since_ns_ = now;
   if ((heard_endcaps & (1U << config_.endcap_id)) != 0) {
