@@ -75,7 +75,17 @@ int main(int argc, char** argv) {
   cli.add_option("--unheard-rejoin-s", o.unheard_rejoin_s,
                  "hearing hosts that hear other end caps but not this one for this long, make a new DDS participant "
                  "(a stalled security handshake; the wait doubles while unanswered, up to 8x); 0: never")
-      ->check(CLI::Range(0.0, 3600.0))
+      ->check(CLI::Validator(
+          [](const std::string& text) -> std::string {
+            // The node's rule (comms::validate): a wait shorter than a host's 2 s hearing window churns.
+            double s = -1.0;
+            try {
+              s = std::stod(text);
+            } catch (const std::exception&) {
+            }
+            return s == 0.0 || (s >= 3.0 && s <= 3600.0) ? "" : "expected 0 (never) or 3..3600 s, got " + text;
+          },
+          "0 or 3..3600"))
       ->capture_default_str();
   cli.add_option("--domain", o.domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
   std::string keystore;

@@ -232,3 +232,31 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
 
 }  // namespace
 }  // namespace tensegrity::fw
+
+namespace {
+// The program's stderr and exit status for `args`, as a shell runs it.
+std::pair<std::string, int> run_endcap(const std::string& args) {
+  const std::string emulator = ENDCAP_EMULATOR;
+  const std::string cmd = (emulator.empty() ? "" : emulator + " ") + ENDCAP_BINARY + " " + args + " 2>&1 >/dev/null";
+  std::string out;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return {"popen failed", -1};
+  char buf[256];
+  while (std::fgets(buf, sizeof buf, pipe) != nullptr) out += buf;
+  const int status = ::pclose(pipe);
+  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+}  // namespace
+
+// The node refuses a rejoin wait under a host's hearing window (comms::validate); the
+// program says so up front, naming its flag, before anything starts.
+TEST(EndcapProcess, ARejoinWaitTheNodeRefusesIsRefusedByItsFlag) {
+  for (const char* bad : {"1", "-5", "5000", "abc"}) {
+    const auto [err, status] =
+        run_endcap(std::string("--id 0 --config ") + ENDCAP_EXAMPLE_CONFIG + " --unheard-rejoin-s " + bad);
+    EXPECT_NE(status, 0) << bad;
+    EXPECT_NE(err.find("--unheard-rejoin-s: expected 0 (never) or 3..3600 s, got " + std::string(bad)),
+              std::string::npos)
+        << err;
+  }
+}
