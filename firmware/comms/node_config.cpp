@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "msgs/security.hpp"
+
 namespace tensegrity::fw::comms {
 
 const char* to_string(HostLossAction action) { return action == HostLossAction::stop ? "stop" : "continue"; }
@@ -21,8 +23,10 @@ void validate(const EndcapNodeConfig& c) {
                                   ": expected > 0 and <= " + std::to_string(max));
     }
   };
-  if (c.endcap_id < 0 || c.endcap_id > 15) {
-    throw std::invalid_argument("endcap_id = " + std::to_string(c.endcap_id) + ": expected 0..15");
+  // The robot's end caps, as the wire names them (its writers and its 12-bit masks).
+  if (c.endcap_id < 0 || c.endcap_id >= msgs::kMaxEndcaps) {
+    throw std::invalid_argument("endcap_id = " + std::to_string(c.endcap_id) + ": expected 0.." +
+                                std::to_string(msgs::kMaxEndcaps - 1));
   }
   if (c.domain < 0 || c.domain > 232) {
     throw std::invalid_argument("domain = " + std::to_string(c.domain) + ": expected 0..232");

@@ -35,6 +35,27 @@ TEST(NodeConfig, TheUnheardRejoinWaitIsZeroOrLongerThanTheHostsHearingWindow) {
   }
 }
 
+TEST(NodeConfig, TheEndcapIdIsOneOfTheRobotsTwelve) {
+  // A host's heard mask and the telemetry writers know ids 0..11 only: an end cap
+  // with id 12 could never be named and would rejoin for ever.
+  for (const int id : {0, 11}) {
+    EndcapNodeConfig c;
+    c.endcap_id = id;
+    EXPECT_NO_THROW(validate(c)) << id;
+  }
+  for (const int id : {-1, 12, 15}) {
+    EndcapNodeConfig c;
+    c.endcap_id = id;
+    try {
+      validate(c);
+      ADD_FAILURE() << id << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("endcap_id = " + std::to_string(id) + ": expected 0..11"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(NodeConfig, TheDefaultsAreValid) { EXPECT_NO_THROW(validate(EndcapNodeConfig{})); }
 
 }  // namespace
