@@ -17,7 +17,9 @@ Error bars are the standard deviation over seeds. A run is identified by its
 parameters; it checkpoints every generation into OUT/runs/<id>/, so the script
 can be stopped and started again: finished runs are reused, unfinished ones
 resume where they stopped. Runs shared by several figures (historical, t = 4 s,
-n = 5) are done once.
+n = 5) are done once. The figures draw every finished run in OUT/runs made with
+the same step and episode length, so a sweep can be run in parts (a few points or
+seeds at a time) without a later part dropping the earlier ones from the plots.
 
 Examples:
   tools/experiments.py --out out/experiments                 # the paper's budget
@@ -199,6 +201,25 @@ def load(a, runs):
     return out
 
 
+def finished_runs(a):
+    """Every finished run in OUT/runs made with this step and episode length, whatever
+    subset of the grid or seeds the command that made it asked for: a sweep run in
+    parts (a few points first, more seeds later) draws all of them every time."""
+    found = {}
+    for summary in sorted((pathlib.Path(a.out) / "runs").glob("*/summary.json")):
+        try:
+            s = json.loads(summary.read_text())
+            r = dict(method=s["method"], period=float(s["period"]), complexity=int(s["complexity"]),
+                     episodes=int(s["episodes"]), seed=int(s["seed"]))
+        except (ValueError, KeyError, TypeError) as e:
+            print(f"experiments: {summary}: skipped, not a run summary ({e})", file=sys.stderr)
+            continue
+        key = run_id(r["method"], r["period"], r["complexity"], r["episodes"], r["seed"], a.duration)
+        if key + a.mutation_tag == summary.parent.name:
+            found[summary.parent.name] = r
+    return found
+
+
 def mean_sd(values):
     if not values:
         return float("nan"), float("nan")
@@ -236,7 +257,7 @@ def write_csv(path, header, rows):
 
 
 def report(a, runs):
-    done = load(a, runs)
+    done = load(a, {**finished_runs(a), **runs})
     out = pathlib.Path(a.out)
     summary = {"episodes": a.episodes, "sweep_episodes": a.sweep_episodes, "seeds": a.seeds,
                "method_seeds": a.method_seeds, "sweep_seeds": a.sweep_seeds, "robot": a.robot}
@@ -275,8 +296,9 @@ def report(a, runs):
                 ax.plot(x, [r[2] for r in mean], color=colour, linestyle="--", label=f"{m}: mean of generation")
             ax.set_xlabel("episodes")
             ax.set_ylabel("distance in 60 s, m")
-            ax.set_title(f"Figure 6: fitness methods (t = 4 s, n = 5; historical {a.seeds} seeds, "
-                         f"others {a.method_seeds}; band = 1 sd)")
+            seeds = {m: summary["methods"][m]["runs"] for m in fig_data}
+            ax.set_title(f"Figure 6: fitness methods (t = 4 s, n = 5; seeds: historical {seeds['historical']}, "
+                         f"leniency {seeds['leniency']}, average {seeds['average']}; band = 1 sd)")
             ax.grid(alpha=0.3)
             ax.legend(fontsize=8)
             fig.tight_layout()
@@ -312,7 +334,7 @@ def report(a, runs):
             h1, l1 = ax.get_legend_handles_labels()
             h2, l2 = ax2.get_legend_handles_labels()
             ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="center right")
-            ax.set_title(f"Figure 7: learning, historical average, t = 4 s, n = 5 ({a.seeds} seeds)")
+            ax.set_title(f"Figure 7: learning, historical average, t = 4 s, n = 5 ({len(reach)} seeds)")
             ax.grid(alpha=0.3)
             fig.tight_layout()
             fig.savefig(out / "fig7_learning.png", dpi=110)
@@ -327,10 +349,17 @@ def report(a, runs):
             sweep_figure.plot(plt, out / f"fig{fig_no}_{name}.png", f"Figure {fig_no}: {name}", label, points,
                               paper, a.sweep_episodes)
 
+    def swept(field, asked, fixed):
+        found = {d[field] for d in done.values() if d["method"] == "historical"
+                 and d["episodes"] == a.sweep_episodes and fixed(d)}
+        return sorted(set(asked) | found)
+
     if 8 in a.figures:
-        sweep("period", 8, [(t, (t, 5)) for t in a.periods], "period_s", PAPER_PERIOD_M)
+        periods = swept("period", a.periods, lambda d: d["complexity"] == 5)
+        sweep("period", 8, [(t, (t, 5)) for t in periods], "period_s", PAPER_PERIOD_M)
     if 9 in a.figures:
-        sweep("complexity", 9, [(n, (4.0, n)) for n in a.complexities], "complexity", {})
+        complexities = swept("complexity", a.complexities, lambda d: d["period"] == 4.0)
+        sweep("complexity", 9, [(n, (4.0, n)) for n in complexities], "complexity", {})
 
     summary["runs_done"], summary["runs_planned"] = len(done), len(runs)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

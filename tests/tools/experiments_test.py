@@ -107,6 +107,25 @@ class Sweep(unittest.TestCase):
             damaged = self.run_sweep(root, robot, check=False)
             self.assertIn("evolve-settings.json is not JSON", damaged.stderr)
 
+    def test_a_sweep_run_in_parts_draws_every_finished_run(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            root = pathlib.Path(tmp)
+            (root / "fake").write_text(FAKE_EVOLVE)
+            (root / "fake").chmod(0o755)
+            robot = root / "robot.json"
+            robot.write_text('{"name": "a"}\n')
+            self.run_sweep(root, robot)  # t = 4 and 6 s, 3 seeds
+            self.run_sweep(root, robot, more=("--periods", "5", "--sweep-seeds", "1"))
+            with open(root / "out" / "fig8_period.csv") as f:
+                rows = {r["period_s"]: r for r in csv.DictReader(f)}
+            self.assertEqual(sorted(rows), ["4", "5", "6"])
+            self.assertEqual((rows["4"]["seeds"], rows["5"]["seeds"], rows["6"]["seeds"]), ("3", "1", "3"))
+            # runs with another step are another experiment: not drawn with these
+            self.run_sweep(root, robot, more=("--periods", "7", "--sweep-seeds", "1", "--sigma", "0.03"))
+            self.run_sweep(root, robot, more=("--plot-only",))
+            with open(root / "out" / "fig8_period.csv") as f:
+                self.assertEqual(sorted(r["period_s"] for r in csv.DictReader(f)), ["4", "5", "6"])
+
 
 if __name__ == "__main__":
     unittest.main()
