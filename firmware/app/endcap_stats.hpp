@@ -41,7 +41,8 @@ struct TablePhase {
 };
 
 struct EndcapStats {
-  static constexpr const char* kFormat = "tensegrity-endcap-stats/1";
+  // 2: link.rejoins (the end cap's new DDS participants).
+  static constexpr const char* kFormat = "tensegrity-endcap-stats/2";
   bool final = false;  // false: a snapshot taken while the program ran
   int endcap = -1;
   std::string mode;  // "realtime" | "lockstep"

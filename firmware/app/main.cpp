@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
                  "identity, file:NAME v0) and loaded");
   cli.add_flag("--start-on-boot", o.start_on_boot, "start playing the table as soon as the drives are enabled");
   cli.add_option("--stats-json", stats_path,
-                 "write the run's statistics (tensegrity-endcap-stats/1) to this file: a snapshot every second, "
+                 "write the run's statistics (tensegrity-endcap-stats/2) to this file: a snapshot every second, "
                  "the full report at exit");
   cli.add_option("--duration-s", o.duration_s, "exit after this many seconds (0: run until SIGINT/SIGTERM)");
   // Accepted in builds without DDS too (where they change nothing), so that

@@ -69,7 +69,7 @@ TEST(EndcapStats, ErrorsNameTheField) {
   EXPECT_THAT(error_of(nlohmann::json::array()), HasSubstr("(top level): must be an object"));
   nlohmann::json bad = j;
   bad["format"] = "tensegrity-endcap-stats/0";
-  EXPECT_THAT(error_of(bad), HasSubstr("stats.json: format: expected \"tensegrity-endcap-stats/1\""));
+  EXPECT_THAT(error_of(bad), HasSubstr("stats.json: format: expected \"tensegrity-endcap-stats/2\""));
   bad = j;
   bad["link"].erase("host_losses");
   EXPECT_THAT(error_of(bad), HasSubstr("stats.json: link.host_losses: missing"));
