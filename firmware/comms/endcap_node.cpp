@@ -116,6 +116,7 @@ void EndcapNode::stop() noexcept {
   // Entities deleted while dds_ still points at them (reset() would null it first).
   if (dds_) dds_->close();
   dds_.reset();
+  retire();
 }
 
 bool EndcapNode::try_take_table(app::HostTable& out) noexcept { return tables_.pop(out); }
@@ -167,8 +168,8 @@ void EndcapNode::run() {
   while (running_.load()) {
     const std::int64_t now = clock_.now_ns();
     service(now);
-    std::int64_t next =
-        dds_ != nullptr ? std::min({next_telemetry_ns_, next_heartbeat_ns_, next_sync_ns_}) : next_remake_ns_;
+    std::int64_t next = std::min({next_telemetry_ns_, next_heartbeat_ns_, next_sync_ns_});
+    if (remake_pending_) next = std::min(next, next_remake_ns_);
     // The loop takes a table within a cycle or two: look again soon, the ack waits on it.
     if (in_flight_.active && !in_flight_.answered) next = std::min(next, now + 1'000'000);
     const std::int64_t wait_ns = std::max<std::int64_t>(0, next - clock_.now_ns());
@@ -185,13 +186,11 @@ void EndcapNode::service(std::int64_t now) {
     last_telemetry_ = t;
     loop_seen_ = true;
   }
-  if (dds_ != nullptr) {
-    handle_host_heartbeats(now);
-    handle_tables(now);
-  }
+  handle_host_heartbeats(*dds_, now);
+  if (retiring_ != nullptr) handle_host_heartbeats(*retiring_, now);  // still hears the host
+  handle_tables(now);
   check_host_loss(now);
-  check_heard(now);             // may replace the participant (node_rejoin.cpp)
-  if (dds_ == nullptr) return;  // a rejoin could not make one: tried again shortly
+  check_heard(now);  // may make a new participant (node_rejoin.cpp)
   if (now >= next_telemetry_ns_) {
     send_telemetry();
     next_telemetry_ns_ += period_ns(config_.telemetry_rate_hz);

@@ -116,7 +116,7 @@ class EndcapNode final : public app::HostLink {
   CommandReason act_on(const CommandSample& c, WireCommandKind kind);
   void send_command_ack(Dds& dds, std::uint32_t seq, CommandReason reason);
   // node_status.cpp
-  void handle_host_heartbeats(std::int64_t now_ns);
+  void handle_host_heartbeats(Dds& dds, std::int64_t now_ns);
   void check_host_loss(std::int64_t now_ns);
   bool loop_alive(std::int64_t now_ns);  // the loop-progress watchdog; logs changes
   void send_telemetry();
@@ -125,7 +125,8 @@ class EndcapNode final : public app::HostLink {
   // node_rejoin.cpp
   void note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now_ns);
   void check_heard(std::int64_t now_ns);
-  void rejoin(std::int64_t now_ns);
+  void rejoin();
+  void retire() noexcept;
   // node_time_sync.cpp
   void send_time_sync_request();
   void report_if_unsynced();
@@ -136,6 +137,9 @@ class EndcapNode final : public app::HostLink {
   Clock& clock_;
   app::PolicyStore* store_;
   std::unique_ptr<Dds> dds_;
+  // After a rejoin, the previous participant, still listening until a host hears
+  // the new one (node_rejoin.cpp). Node thread only.
+  std::unique_ptr<Dds> retiring_;
 
   // Loop <-> node hand-over.
   app::SpscRing<app::HostTable, 4> tables_;
@@ -165,7 +169,8 @@ class EndcapNode final : public app::HostLink {
   std::int64_t others_named_ns_ = 0;        // ... named another end cap
   std::int64_t others_named_since_ns_ = 0;  // ... and had, without a gap, since
   std::int64_t participant_since_ns_ = 0;   // this participant was made
-  std::int64_t next_remake_ns_ = 0;         // no participant (making one failed): next try
+  bool remake_pending_ = false;             // making a new participant failed ...
+  std::int64_t next_remake_ns_ = 0;         // ... and is tried again then
   double rejoin_wait_s_ = 0.0;              // doubles while rejoins go unanswered
   std::uint32_t telemetry_sequence_ = 0;
   std::uint32_t heartbeat_sequence_ = 0;
@@ -180,8 +185,9 @@ class EndcapNode final : public app::HostLink {
   std::int64_t loop_progress_ns_ = 0;  // node clock when the counter last moved
   bool loop_stall_reported_ = false;
 
-  // Command listener state: guarded by Dds::callback_mutex (Fast DDS may call
-  // from more than one receive thread).
+  // Command listener state: guarded by receive_mutex_ (Fast DDS may call from more
+  // than one receive thread, and after a rejoin two participants listen).
+  std::mutex receive_mutex_;
   CommandGate gate_;
   StartTimeMapper start_mapper_;
   LoopClockPoint loop_point_{};

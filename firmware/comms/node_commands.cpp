@@ -43,6 +43,7 @@ const char* kind_name(std::uint8_t kind) {
 void EndcapNode::on_commands(Dds& d) {
   std::lock_guard guard(d.callback_mutex);
   if (d.closed || d.command == nullptr) return;  // stopping, or still starting (taken next time)
+  std::lock_guard serial(receive_mutex_);        // the other participant's listener, after a rejoin
   m::Command_ cmd;
   dds::SampleInfo info;
   while (d.command->take_next_sample(&cmd, &info) == ReturnCode_t::RETCODE_OK) {

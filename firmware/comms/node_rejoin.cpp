@@ -20,7 +20,7 @@ namespace tensegrity::fw::comms {
 
 namespace {
 constexpr double kMaxBackoff = 8.0;                     // the wait grows to at most 8 x unheard_rejoin_s
-constexpr std::int64_t kOthersFreshNs = 2'000'000'000;  // "the host hears other end caps" means now
+constexpr std::int64_t kHostWindowNs = 2'000'000'000;   // a host's heard mask covers its last 2 s
 constexpr std::int64_t kRemakeRetryNs = 1'000'000'000;  // making a participant failed: try again after
 constexpr std::uint16_t kRobotsEndcaps = (1U << msgs::kMaxEndcaps) - 1;
 std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
@@ -31,23 +31,38 @@ void EndcapNode::note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t n
   // A host heard again after a loss (or for the first time) gets a full wait to hear us.
   if (!host_seen_ || host_lost_.load()) hearing_since_ns_ = now;
   if ((heard_endcaps & (1U << config_.endcap_id)) != 0) {
-    if (named_ns_ < participant_since_ns_) rejoin_wait_s_ = config_.unheard_rejoin_s;  // a rejoin answered
+    // Named once the old participant's last heartbeats have left the host's window:
+    // the new one is heard, the rejoin answered.
+    if (now - participant_since_ns_ > kHostWindowNs && named_ns_ - participant_since_ns_ <= kHostWindowNs) {
+      rejoin_wait_s_ = config_.unheard_rejoin_s;
+    }
     named_ns_ = now;
   }
   // The evidence against this end cap starts when hosts begin to hear others.
   if ((heard_endcaps & ~(1U << config_.endcap_id)) != 0) {
-    if (now - others_named_ns_ > kOthersFreshNs) others_named_since_ns_ = now;
+    if (now - others_named_ns_ > kHostWindowNs) others_named_since_ns_ = now;
     others_named_ns_ = now;
   }
 }
 
 void EndcapNode::check_heard(std::int64_t now) {
-  if (dds_ == nullptr) {
-    if (now >= next_remake_ns_) rejoin(now);
+  if (retiring_ != nullptr && named_ns_ - participant_since_ns_ > kHostWindowNs) {
+    retire();
+    log("a host hears the new DDS participant: the old one closed");
+  }
+  if (remake_pending_ && now - named_ns_ < kHostWindowNs) remake_pending_ = false;  // heard again meanwhile
+  if (remake_pending_) {
+    if (now >= next_remake_ns_) rejoin();
     return;
   }
   if (config_.unheard_rejoin_s == 0.0 || !host_seen_ || host_lost_.load()) return;
-  if (now - others_named_ns_ > kOthersFreshNs) return;
+  // A stalled loop withholds the heartbeat on purpose: no host can name us then,
+  // and a new participant would not change that. The wait starts again after it.
+  if (loop_stall_reported_) {
+    hearing_since_ns_ = now;
+    return;
+  }
+  if (now - others_named_ns_ > kHostWindowNs) return;
   const std::int64_t since = std::max({named_ns_, hearing_since_ns_, others_named_since_ns_, participant_since_ns_});
   if (now - since < to_ns(rejoin_wait_s_)) return;
   log("hearing the host, which hears other end caps, but not heard by it for %.0f s: a new DDS participant "
@@ -55,28 +70,41 @@ void EndcapNode::check_heard(std::int64_t now) {
       static_cast<double>(now - since) * 1e-9,
       static_cast<unsigned long long>(rejoins_.load(std::memory_order_relaxed) + 1));
   rejoin_wait_s_ = std::min(2.0 * rejoin_wait_s_, kMaxBackoff * config_.unheard_rejoin_s);
-  rejoin(now);
+  rejoin();
 }
 
-// On the node thread, the only one that uses dds_: the old participant is closed
-// first (its listeners finish and are refused from then on), so the command gate
-// never sees two participants' receive threads at once.
-void EndcapNode::rejoin(std::int64_t now) {
-  if (dds_ != nullptr) {
-    dds_->close();
-    dds_.reset();
-    rejoins_.fetch_add(1, std::memory_order_relaxed);
-  }
+// On the node thread, the only one that uses dds_. The new participant is made
+// before the old one goes: the stall may be one way only, so the old one can still
+// carry orders in (an emergency stop among them) until a host hears the new one,
+// and it stays for good if a new one cannot be made. The two participants' command
+// listeners take turns (receive_mutex_); only the new one writes.
+void EndcapNode::rejoin() {
+  std::unique_ptr<Dds> fresh;
   try {
-    dds_ = make_dds();
+    fresh = make_dds();
   } catch (const std::exception& e) {
-    log("cannot make a DDS participant: %s; trying again in %.0f s", e.what(), kRemakeRetryNs * 1e-9);
-    next_remake_ns_ = now + kRemakeRetryNs;
+    log("cannot make a new DDS participant: %s; the old one stays, trying again in %.0f s", e.what(),
+        static_cast<double>(kRemakeRetryNs) * 1e-9);
+    remake_pending_ = true;
+    next_remake_ns_ = clock_.now_ns() + kRemakeRetryNs;  // from the end of an attempt that took a while
     return;
   }
-  participant_since_ns_ = now;
+  remake_pending_ = false;
+  retire();  // an older one still listening: never more than two
+  retiring_ = std::move(dds_);
+  dds_ = std::move(fresh);
+  rejoins_.fetch_add(1, std::memory_order_relaxed);
+  // Counted from when it exists: a secured participant takes a second or more to make.
+  const std::int64_t made = clock_.now_ns();
+  participant_since_ns_ = made;
   // Send at once on the new participant; a table half way to the loop is acked from it.
-  next_telemetry_ns_ = next_heartbeat_ns_ = next_sync_ns_ = now;
+  next_telemetry_ns_ = next_heartbeat_ns_ = next_sync_ns_ = made;
+}
+
+void EndcapNode::retire() noexcept {
+  if (retiring_ == nullptr) return;
+  retiring_->close();  // its listeners finish and are refused from then on
+  retiring_.reset();
 }
 
 }  // namespace tensegrity::fw::comms

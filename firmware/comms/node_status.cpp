@@ -13,10 +13,10 @@ namespace tensegrity::fw::comms {
 
 namespace m = tensegrity_msgs::msg::dds_;
 
-void EndcapNode::handle_host_heartbeats(std::int64_t now) {
+void EndcapNode::handle_host_heartbeats(Dds& d, std::int64_t now) {
   m::Heartbeat_ hb;
   dds::SampleInfo info;
-  while (dds_->host_heartbeat->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
+  while (d.host_heartbeat->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
     if (hb.format_version() != msgs::kFormatVersion) {
       if (refused_format_++ % 100 == 0) {

@@ -35,7 +35,8 @@ using test::Subprocess;
 
 constexpr int kEndcap = 3;
 constexpr double kRejoinS = 3.0;  // the smallest wait the node accepts
-constexpr const char* kRejoinLine = "a new DDS participant";
+constexpr const char* kRejoinLine = "a new DDS participant (rejoin";
+constexpr const char* kRetireLine = "the old one closed";
 
 // A host that publishes its heartbeat at 5 Hz naming the end caps in `names`,
 // whatever it hears: the forged symptom of a handshake stalled in one direction.
@@ -89,10 +90,11 @@ class EndcapRejoin : public ::testing::Test {
     node_.reset();
     fs::remove_all(dir_);
   }
-  void start_node(int domain, const fs::path& keystore = {}) {
+  void start_node(int domain, const fs::path& keystore = {}, const std::vector<std::string>& more = {}) {
     std::vector<std::string> argv{COMMS_TEST_NODE,         "--domain",           std::to_string(domain),  "--endcaps",
                                   std::to_string(kEndcap), "--unheard-rejoin-s", std::to_string(kRejoinS)};
     if (!keystore.empty()) argv.insert(argv.end(), {"--keystore", keystore.string()});
+    argv.insert(argv.end(), more.begin(), more.end());
     node_ = std::make_unique<Subprocess>(argv, dir_ / "node.out", dir_ / "node.err");
     ASSERT_TRUE(node_->wait_for_output("READY", std::chrono::seconds(30)));
   }
@@ -132,6 +134,8 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   const auto t0 = std::chrono::steady_clock::now();
   NamingHost deaf(domain, kOthers, enclave(msgs::Role::ground, -1));
   ASSERT_TRUE(t.wait_for_rejoins(1, std::chrono::seconds(40))) << t.log();
+  // The old participant keeps listening while no host hears the new one.
+  EXPECT_EQ(t.log().find(kRetireLine), std::string::npos) << t.log();
   // Not before the wait: the end cap gave the host kRejoinS to hear it.
   EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), kRejoinS - 0.3);
   EXPECT_NE(t.log().find("rejoin 1"), std::string::npos) << t.log();
@@ -149,6 +153,14 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   o.enclave_dir = enclave(msgs::Role::ground, -1);
   Station station(o);
   ASSERT_TRUE(station.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
+  // Named by the station (past the host's 2 s window), the new one is known to be
+  // heard: the old one closes, once.
+  const auto named = std::chrono::steady_clock::now();
+  while (t.log().find(kRetireLine) == std::string::npos &&
+         std::chrono::steady_clock::now() - named < std::chrono::seconds(10)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_NE(t.log().find(kRetireLine), std::string::npos) << t.log();
   CommandOptions c;
   c.endcap_mask = 1U << kEndcap;
   c.retry_interval_s = kEstopRetryIntervalS;
@@ -162,6 +174,10 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   const int after = t.rejoins();
   std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
   EXPECT_EQ(t.rejoins(), after) << t.log();
+  const std::string text = t.log();
+  EXPECT_EQ(text.find(kRetireLine), text.rfind(kRetireLine)) << text;
+  // The old participant heard the host all along: no host loss, secured or not.
+  EXPECT_EQ(text.find("host LOST"), std::string::npos) << text;
 }
 
 TEST_F(EndcapRejoin, AnEndcapNoHostHearsJoinsAgainAndItsNewParticipantObeys) { joins_again_and_obeys(*this, 189, {}); }
@@ -190,6 +206,23 @@ TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsPart
   // The control: without it, the same deaf host makes the end cap join again.
   hearing.name(kOthers);
   EXPECT_TRUE(wait_for_rejoins(1, std::chrono::seconds(20))) << log();
+}
+
+// A hung control loop withholds the end cap's heartbeat on purpose (the host must
+// see it as dead): no host names it then, and a new participant would not change
+// that. The same deaf host that makes a healthy end cap join again after kRejoinS
+// (above) must not make this one churn.
+TEST_F(EndcapRejoin, AnEndcapWhoseLoopHungKeepsItsParticipant) {
+  constexpr int kDomain = 195;
+  start_node(kDomain, {}, {"--loop-stall-after-s", "0.5"});
+  NamingHost deaf(kDomain, kOthers);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (log().find("control loop STALLED") == std::string::npos && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_NE(log().find("control loop STALLED"), std::string::npos) << log();
+  std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
+  EXPECT_EQ(rejoins(), 0) << log();
 }
 
 }  // namespace

@@ -6,12 +6,16 @@
 //   comms_test_node --domain D [--endcaps 0-11] [--loop-hz 500] [--telemetry-hz 100]
 //     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
-//     [--stall-commands] [--dds-cut-signals] [--keystore DIR]
+//     [--stall-commands] [--dds-cut-signals] [--keystore DIR] [--unheard-rejoin-s S]
+//     [--loop-stall-after-s S]
 // --stall-commands: the stub loops never take a command from the mailbox (it
 // fills up), but read the emergency-stop counter every cycle.
 // --dds-cut-signals: SIGUSR1 cuts every node's DDS link, SIGUSR2 restores it.
 // --keystore: DDS Security, end cap N with the keystore's enclave endcap_NN.
+// --loop-stall-after-s: the nodes watch a loop-progress counter (as the endcap
+// program's do) that moves until S seconds after the start, then hangs for good.
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -19,6 +23,7 @@
 #include <memory>
 #include <random>
 #include <stdexcept>
+#include <stop_token>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,6 +40,7 @@ volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 std::atomic<bool> g_link_cut{false};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
+std::atomic<std::uint64_t> g_loop_progress{0};
 
 // "0-11", "3", "0,2,5-7" -> bit mask
 unsigned parse_set(const std::string& text) {
@@ -74,6 +80,7 @@ int main(int argc, char** argv) {
   std::string storage_dir;
   bool stall_commands = false;
   bool cut_signals = false;
+  double loop_stall_after_s = -1.0;  // never
   std::string keystore;
   fw::comms::EndcapNodeConfig base;
   try {
@@ -113,6 +120,8 @@ int main(int argc, char** argv) {
         cut_signals = true;
       else if (arg == "--keystore")
         keystore = value();
+      else if (arg == "--loop-stall-after-s")
+        loop_stall_after_s = std::stod(value());
       else
         throw std::invalid_argument("unknown argument " + arg);
     }
@@ -128,6 +137,18 @@ int main(int argc, char** argv) {
     std::signal(SIGUSR1, on_link_signal);
     std::signal(SIGUSR2, on_link_signal);
     base.link_cut = &g_link_cut;
+  }
+
+  std::jthread progress;
+  if (loop_stall_after_s >= 0.0) {
+    base.loop_progress = &g_loop_progress;
+    progress = std::jthread([loop_stall_after_s](const std::stop_token& stop) {
+      const auto hang = std::chrono::steady_clock::now() + std::chrono::duration<double>(loop_stall_after_s);
+      while (!stop.stop_requested()) {
+        if (std::chrono::steady_clock::now() < hang) g_loop_progress.fetch_add(1, std::memory_order_relaxed);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    });
   }
 
   std::mt19937_64 rng(1234);  // the same offsets every run
