@@ -145,6 +145,28 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   ASSERT_TRUE(t.wait_for_rejoins(2, std::chrono::seconds(40))) << t.log();
   EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 2 * kRejoinS - 0.5);
 
+  // Two participants listen now (the old one until a host names the new one): an
+  // emergency stop from a station that names nobody, and so retires nothing, lands
+  // on them once and in bounded time.
+  {
+    StationOptions silent;
+    silent.domain = domain;
+    silent.name = "rejoin_test_silent_station";
+    silent.publish_heartbeat = false;
+    silent.enclave_dir = enclave(msgs::Role::ground, -1);
+    Station observer(silent);
+    ASSERT_TRUE(observer.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
+    CommandOptions c;
+    c.endcap_mask = 1U << kEndcap;
+    c.retry_interval_s = kEstopRetryIntervalS;
+    const CommandReport estop = send_command(observer, CommandKind::emergency_stop, 0, c);
+    EXPECT_TRUE(estop.all_accepted()) << t.log();
+    ASSERT_EQ(estop.results.size(), 1U);
+    std::printf("estop while two participants listen: acked after %.1f ms\n", estop.results[0].latency_s * 1e3);
+    EXPECT_LT(estop.results[0].latency_s, 0.5);
+    EXPECT_EQ(t.log().find(kRetireLine), std::string::npos) << t.log();
+  }
+
   // A real station beside the deaf host hears the new participant and names it: no
   // more rejoins, and an emergency stop lands on it.
   StationOptions o;
