@@ -169,9 +169,12 @@ class EndcapNode final : public app::HostLink {
   std::int64_t others_named_ns_ = 0;        // ... named another end cap
   std::int64_t others_named_since_ns_ = 0;  // ... and had, without a gap, since
   std::int64_t participant_since_ns_ = 0;   // this participant was made
+  bool current_hears_host_ = false;         // dds_ has taken a host heartbeat
   bool remake_pending_ = false;             // making a new participant failed ...
-  std::int64_t next_remake_ns_ = 0;         // ... and is tried again then
-  double rejoin_wait_s_ = 0.0;              // doubles while rejoins go unanswered
+  std::int64_t next_remake_ns_ = 0;         // ... and is tried again then,
+  std::int64_t remake_retry_ns_ = 0;        // ... after this (doubling)
+  std::uint32_t remake_failures_ = 0;
+  double rejoin_wait_s_ = 0.0;  // doubles while rejoins go unanswered
   std::uint32_t telemetry_sequence_ = 0;
   std::uint32_t heartbeat_sequence_ = 0;
   std::uint32_t sync_sequence_ = 0;

@@ -66,7 +66,8 @@ struct EndcapNode::Dds {
   // arriving while the node stopped reached through a half-destroyed object
   // (seen: SIGSEGV at exit).
   std::mutex callback_mutex;
-  bool closed = false;  // guarded by callback_mutex
+  bool closed = false;    // guarded by callback_mutex
+  bool retiring = false;  // replaced by a new participant, still listening; guarded by callback_mutex
 
   ~Dds() { close(); }
   void close() noexcept {

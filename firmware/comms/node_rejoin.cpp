@@ -19,9 +19,10 @@
 namespace tensegrity::fw::comms {
 
 namespace {
-constexpr double kMaxBackoff = 8.0;                     // the wait grows to at most 8 x unheard_rejoin_s
-constexpr std::int64_t kHostWindowNs = 2'000'000'000;   // a host's heard mask covers its last 2 s
-constexpr std::int64_t kRemakeRetryNs = 1'000'000'000;  // making a participant failed: try again after
+constexpr double kMaxBackoff = 8.0;                         // the wait grows to at most 8 x unheard_rejoin_s
+constexpr std::int64_t kHostWindowNs = 2'000'000'000;       // a host's heard mask covers its last 2 s
+constexpr std::int64_t kRemakeRetryNs = 1'000'000'000;      // making a participant failed: try again after,
+constexpr std::int64_t kRemakeRetryMaxNs = 60'000'000'000;  // doubling up to this
 constexpr std::uint16_t kRobotsEndcaps = (1U << msgs::kMaxEndcaps) - 1;
 std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
 }  // namespace
@@ -46,11 +47,17 @@ void EndcapNode::note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t n
 }
 
 void EndcapNode::check_heard(std::int64_t now) {
-  if (retiring_ != nullptr && named_ns_ - participant_since_ns_ > kHostWindowNs) {
+  // The old participant goes once the link works both ways on the new one: a host
+  // names it, and it has taken a host heartbeat itself.
+  if (retiring_ != nullptr && named_ns_ - participant_since_ns_ > kHostWindowNs && current_hears_host_) {
     retire();
-    log("a host hears the new DDS participant: the old one closed");
+    log("a host hears the new DDS participant and it hears the host: the old one closed");
   }
-  if (remake_pending_ && now - named_ns_ < kHostWindowNs) remake_pending_ = false;  // heard again meanwhile
+  if (config_.unheard_rejoin_s == 0.0 || !host_seen_ || host_lost_.load() || loop_stall_reported_ ||
+      now - named_ns_ < kHostWindowNs) {
+    remake_pending_ = false;  // whatever asked for a new participant holds no more
+    remake_failures_ = 0;
+  }
   if (remake_pending_) {
     if (now >= next_remake_ns_) rejoin();
     return;
@@ -75,24 +82,36 @@ void EndcapNode::check_heard(std::int64_t now) {
 
 // On the node thread, the only one that uses dds_. The new participant is made
 // before the old one goes: the stall may be one way only, so the old one can still
-// carry orders in (an emergency stop among them) until a host hears the new one,
-// and it stays for good if a new one cannot be made. The two participants' command
-// listeners take turns (receive_mutex_); only the new one writes.
+// carry orders in (an emergency stop among them) until the link works both ways on
+// the new one, and it stays for good if a new one cannot be made. The two
+// participants' command listeners take turns (receive_mutex_), each acking on its
+// own participant; telemetry and heartbeats go out on the new one only.
 void EndcapNode::rejoin() {
   std::unique_ptr<Dds> fresh;
   try {
     fresh = make_dds();
   } catch (const std::exception& e) {
+    // Retried while the reason for it holds, less often each time (a missing
+    // certificate does not come back in a second; a secured try blocks this thread).
+    remake_retry_ns_ = remake_pending_ ? std::min(2 * remake_retry_ns_, kRemakeRetryMaxNs) : kRemakeRetryNs;
     log("cannot make a new DDS participant: %s; the old one stays, trying again in %.0f s", e.what(),
-        static_cast<double>(kRemakeRetryNs) * 1e-9);
+        static_cast<double>(remake_retry_ns_) * 1e-9);
     remake_pending_ = true;
-    next_remake_ns_ = clock_.now_ns() + kRemakeRetryNs;  // from the end of an attempt that took a while
+    ++remake_failures_;
+    next_remake_ns_ = clock_.now_ns() + remake_retry_ns_;  // from the end of an attempt that took a while
     return;
   }
+  if (remake_failures_ > 0) log("made a new DDS participant after %u failed attempts", remake_failures_);
   remake_pending_ = false;
+  remake_failures_ = 0;
   retire();  // an older one still listening: never more than two
   retiring_ = std::move(dds_);
+  {
+    std::lock_guard lock(retiring_->callback_mutex);
+    retiring_->retiring = true;
+  }
   dds_ = std::move(fresh);
+  current_hears_host_ = false;
   rejoins_.fetch_add(1, std::memory_order_relaxed);
   // Counted from when it exists: a secured participant takes a second or more to make.
   const std::int64_t made = clock_.now_ns();

@@ -28,6 +28,7 @@ void EndcapNode::handle_host_heartbeats(Dds& d, std::int64_t now) {
     note_host_heartbeat(hb.heard_endcaps(), now);
     last_host_heartbeat_ns_ = now;
     host_seen_ = true;
+    if (&d == dds_.get()) current_hears_host_ = true;  // after a rejoin: the new one hears too
   }
 }
 

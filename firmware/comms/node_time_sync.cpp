@@ -41,6 +41,7 @@ void EndcapNode::report_if_unsynced() {
 void EndcapNode::on_time_sync_reply(Dds& d) {
   std::lock_guard guard(d.callback_mutex);
   if (d.closed || d.sync_reply == nullptr) return;  // stopping, or still starting (taken next time)
+  if (d.retiring) return;                           // its replies reach the new participant too: counted there once
   m::TimeSyncReply_ reply;
   dds::SampleInfo info;
   while (d.sync_reply->take_next_sample(&reply, &info) == ReturnCode_t::RETCODE_OK) {

@@ -233,18 +233,26 @@ TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsPart
 // A hung control loop withholds the end cap's heartbeat on purpose (the host must
 // see it as dead): no host names it then, and a new participant would not change
 // that. The same deaf host that makes a healthy end cap join again after kRejoinS
-// (above) must not make this one churn.
+// (above) must not make this one churn while its loop hangs; once the loop moves
+// again, the wait starts afresh and the deaf host gets its rejoin.
 TEST_F(EndcapRejoin, AnEndcapWhoseLoopHungKeepsItsParticipant) {
   constexpr int kDomain = 195;
-  start_node(kDomain, {}, {"--loop-stall-after-s", "0.5"});
+  constexpr double kHangS = 10.0;  // more than 3 waits
+  start_node(kDomain, {}, {"--loop-stall-after-s", "0.5", "--loop-stall-for-s", std::to_string(kHangS)});
   NamingHost deaf(kDomain, kOthers);
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  while (log().find("control loop STALLED") == std::string::npos && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_NE(log().find("control loop STALLED"), std::string::npos) << log();
-  std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
+  auto wait_for = [this](const char* line, double s) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+    while (log().find(line) == std::string::npos && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return log().find(line) != std::string::npos;
+  };
+  ASSERT_TRUE(wait_for("control loop STALLED", 5.0)) << log();
+  ASSERT_TRUE(wait_for("control loop progressing again", kHangS + 5.0)) << log();
   EXPECT_EQ(rejoins(), 0) << log();
+  const auto resumed = std::chrono::steady_clock::now();
+  ASSERT_TRUE(wait_for_rejoins(1, std::chrono::seconds(15))) << log();
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - resumed).count(), kRejoinS - 0.5);
 }
 
 }  // namespace

@@ -7,13 +7,15 @@
 //     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
 //     [--stall-commands] [--dds-cut-signals] [--keystore DIR] [--unheard-rejoin-s S]
-//     [--loop-stall-after-s S]
+//     [--loop-stall-after-s S [--loop-stall-for-s D]]
 // --stall-commands: the stub loops never take a command from the mailbox (it
 // fills up), but read the emergency-stop counter every cycle.
 // --dds-cut-signals: SIGUSR1 cuts every node's DDS link, SIGUSR2 restores it.
 // --keystore: DDS Security, end cap N with the keystore's enclave endcap_NN.
 // --loop-stall-after-s: the nodes watch a loop-progress counter (as the endcap
-// program's do) that moves until S seconds after the start, then hangs for good.
+// program's do) that moves until S seconds after the start, then hangs (for good, or
+// for D seconds with --loop-stall-for-s).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -81,6 +83,7 @@ int main(int argc, char** argv) {
   bool stall_commands = false;
   bool cut_signals = false;
   double loop_stall_after_s = -1.0;  // never
+  double loop_stall_for_s = 1e9;     // for good
   std::string keystore;
   fw::comms::EndcapNodeConfig base;
   try {
@@ -122,6 +125,8 @@ int main(int argc, char** argv) {
         keystore = value();
       else if (arg == "--loop-stall-after-s")
         loop_stall_after_s = std::stod(value());
+      else if (arg == "--loop-stall-for-s")
+        loop_stall_for_s = std::stod(value());
       else
         throw std::invalid_argument("unknown argument " + arg);
     }
@@ -142,10 +147,14 @@ int main(int argc, char** argv) {
   std::jthread progress;
   if (loop_stall_after_s >= 0.0) {
     base.loop_progress = &g_loop_progress;
-    progress = std::jthread([loop_stall_after_s](const std::stop_token& stop) {
-      const auto hang = std::chrono::steady_clock::now() + std::chrono::duration<double>(loop_stall_after_s);
+    progress = std::jthread([loop_stall_after_s, loop_stall_for_s](const std::stop_token& stop) {
+      using seconds = std::chrono::duration<double>;
+      const auto hang = std::chrono::steady_clock::now() + seconds(loop_stall_after_s);
+      const auto resume = hang + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     seconds(std::min(loop_stall_for_s, 1e6)));
       while (!stop.stop_requested()) {
-        if (std::chrono::steady_clock::now() < hang) g_loop_progress.fetch_add(1, std::memory_order_relaxed);
+        const auto now = std::chrono::steady_clock::now();
+        if (now < hang || now >= resume) g_loop_progress.fetch_add(1, std::memory_order_relaxed);
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
     });
