@@ -123,6 +123,29 @@ class EndcapRejoin : public ::testing::Test {
 
 constexpr std::uint16_t kOthers = kAllEndcaps & ~(1U << kEndcap);
 
+StationOptions station_options(int domain, const char* name, const fs::path& enclave_dir, bool heartbeat) {
+  StationOptions o;
+  o.domain = domain;
+  o.name = name;
+  o.publish_heartbeat = heartbeat;
+  o.enclave_dir = enclave_dir;
+  return o;
+}
+
+// From a station that hears end cap 3, its emergency stop is acked within 0.5 s, as
+// on any link (tests/ground/estop_dds_test.cpp bounds it at about 0.4 s).
+void estop_lands(Station& station, const EndcapRejoin& t, const char* when) {
+  ASSERT_TRUE(station.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
+  CommandOptions c;
+  c.endcap_mask = 1U << kEndcap;
+  c.retry_interval_s = kEstopRetryIntervalS;
+  const CommandReport estop = send_command(station, CommandKind::emergency_stop, 0, c);
+  EXPECT_TRUE(estop.all_accepted()) << t.log();
+  ASSERT_EQ(estop.results.size(), 1U);
+  std::printf("estop %s: acked after %.1f ms\n", when, estop.results[0].latency_s * 1e3);
+  EXPECT_LT(estop.results[0].latency_s, 0.5);
+}
+
 // Both tests below: a host that hears others but not end cap 3 makes it join again,
 // after the wait and then after twice the wait; a station beside it then hears the new
 // participant (which no longer rejoins) and its emergency stop lands.
@@ -149,31 +172,14 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   // emergency stop from a station that names nobody, and so retires nothing, lands
   // on them once and in bounded time.
   {
-    StationOptions silent;
-    silent.domain = domain;
-    silent.name = "rejoin_test_silent_station";
-    silent.publish_heartbeat = false;
-    silent.enclave_dir = enclave(msgs::Role::ground, -1);
-    Station observer(silent);
-    ASSERT_TRUE(observer.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
-    CommandOptions c;
-    c.endcap_mask = 1U << kEndcap;
-    c.retry_interval_s = kEstopRetryIntervalS;
-    const CommandReport estop = send_command(observer, CommandKind::emergency_stop, 0, c);
-    EXPECT_TRUE(estop.all_accepted()) << t.log();
-    ASSERT_EQ(estop.results.size(), 1U);
-    std::printf("estop while two participants listen: acked after %.1f ms\n", estop.results[0].latency_s * 1e3);
-    EXPECT_LT(estop.results[0].latency_s, 0.5);
+    Station silent(station_options(domain, "rejoin_test_silent_station", enclave(msgs::Role::ground, -1), false));
+    estop_lands(silent, t, "while two participants listen");
     EXPECT_EQ(t.log().find(kRetireLine), std::string::npos) << t.log();
   }
 
   // A real station beside the deaf host hears the new participant and names it: no
   // more rejoins, and an emergency stop lands on it.
-  StationOptions o;
-  o.domain = domain;
-  o.name = "rejoin_test_station";
-  o.enclave_dir = enclave(msgs::Role::ground, -1);
-  Station station(o);
+  Station station(station_options(domain, "rejoin_test_station", enclave(msgs::Role::ground, -1), true));
   ASSERT_TRUE(station.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
   // Named by the station (past the host's 2 s window), the new one is known to be
   // heard: the old one closes, once.
@@ -183,16 +189,7 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   EXPECT_NE(t.log().find(kRetireLine), std::string::npos) << t.log();
-  CommandOptions c;
-  c.endcap_mask = 1U << kEndcap;
-  c.retry_interval_s = kEstopRetryIntervalS;
-  const CommandReport estop = send_command(station, CommandKind::emergency_stop, 0, c);
-  EXPECT_TRUE(estop.all_accepted()) << t.log();
-  // From a station that already hears the new participant the stop lands as on any
-  // link (tests/ground/estop_dds_test.cpp bounds it at about 0.4 s; 1-2 ms measured here).
-  ASSERT_EQ(estop.results.size(), 1U);
-  std::printf("estop on the rejoined end cap: acked after %.1f ms\n", estop.results[0].latency_s * 1e3);
-  EXPECT_LT(estop.results[0].latency_s, 0.5);
+  estop_lands(station, t, "on the rejoined end cap");
   const int after = t.rejoins();
   std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
   EXPECT_EQ(t.rejoins(), after) << t.log();
