@@ -257,7 +257,8 @@ def write_csv(path, header, rows):
 
 
 def report(a, runs):
-    done = load(a, {**finished_runs(a), **runs})
+    drawn = {**finished_runs(a), **runs}  # what the page shows: asked for now, or finished before
+    done = load(a, drawn)
     out = pathlib.Path(a.out)
     summary = {"episodes": a.episodes, "sweep_episodes": a.sweep_episodes, "seeds": a.seeds,
                "method_seeds": a.method_seeds, "sweep_seeds": a.sweep_seeds, "robot": a.robot}
@@ -361,7 +362,7 @@ def report(a, runs):
         complexities = swept("complexity", a.complexities, lambda d: d["period"] == 4.0)
         sweep("complexity", 9, [(n, (4.0, n)) for n in complexities], "complexity", {})
 
-    summary["runs_done"], summary["runs_planned"] = len(done), len(runs)
+    summary["runs_done"], summary["runs_planned"] = len(done), len(drawn)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary, indent=2))
 

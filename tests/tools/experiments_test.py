@@ -120,6 +120,9 @@ class Sweep(unittest.TestCase):
                 rows = {r["period_s"]: r for r in csv.DictReader(f)}
             self.assertEqual(sorted(rows), ["4", "5", "6"])
             self.assertEqual((rows["4"]["seeds"], rows["5"]["seeds"], rows["6"]["seeds"]), ("3", "1", "3"))
+            # its summary counts the runs it draws, not only the last part's
+            summary = json.loads((root / "out" / "summary.json").read_text())
+            self.assertEqual((summary["runs_done"], summary["runs_planned"]), (7, 7))
             # runs with another step are another experiment: not drawn with these
             self.run_sweep(root, robot, more=("--periods", "7", "--sweep-seeds", "1", "--sigma", "0.03"))
             self.run_sweep(root, robot, more=("--plot-only",))
