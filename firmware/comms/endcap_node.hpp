@@ -106,6 +106,7 @@ class EndcapNode final : public app::HostLink {
   void wake();
   // node_tables.cpp
   void handle_tables(std::int64_t now_ns);
+  void take_tables(Dds& dds);
   void judge_table(const PolicyTableMsg& msg, std::int64_t now_ns);
   void hand_over(const PolicyTableMsg& msg, const core::EndcapTable& table, std::int64_t now_ns);
   void finish_in_flight(std::int64_t now_ns);

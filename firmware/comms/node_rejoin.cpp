@@ -29,8 +29,13 @@ std::int64_t to_ns(double s) { return std::llround(s * 1e9); }
 
 void EndcapNode::note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now) {
   heard_endcaps &= kRobotsEndcaps;  // bits of end caps the robot does not have mean nothing
-  // A host heard again after a loss (or for the first time) gets a full wait to hear us.
-  if (!host_seen_ || host_lost_.load()) hearing_since_ns_ = now;
+  // A host heard again after a loss (or for the first time) gets a full wait to hear
+  // us, and the first one: the back-off answered a host that never heard us, and a
+  // host that came back (restarted, or another one) is not known to be that host.
+  if (!host_seen_ || host_lost_.load()) {
+    hearing_since_ns_ = now;
+    rejoin_wait_s_ = config_.unheard_rejoin_s;
+  }
   if ((heard_endcaps & (1U << config_.endcap_id)) != 0) {
     // Named once the old participant's last heartbeats have left the host's window:
     // the new one is heard, the rejoin answered.

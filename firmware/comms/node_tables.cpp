@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Policy tables: judge, store (table + identity, one durable record), hand to the
 // loop, acknowledge once the loop took it. docs/dds.md "Policy upload".
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -18,17 +19,30 @@ namespace {
 std::int64_t to_ns(double seconds) { return core::seconds_to_ns(seconds); }
 }  // namespace
 
-void EndcapNode::handle_tables(std::int64_t now) {
+// During a rejoin's overlap (node_rejoin.cpp) the old participant may be the only
+// one that hears the host: its tables count as much as the new one's. A table that
+// reaches both is taken once here, or, if the first copy has left the inbox, judged
+// as a retry and given the same answer.
+void EndcapNode::take_tables(Dds& d) {
   PolicyTableMsg msg;
   dds::SampleInfo info;
-  while (dds_->policy->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+  while (d.policy->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data || msg.target_endcap() != config_.endcap_id) continue;  // another end cap's table
+    const bool queued = std::any_of(inbox_.begin(), inbox_.end(), [&](const PolicyTableMsg& q) {
+      return q.upload_sequence() == msg.upload_sequence() && policy_digest(q) == policy_digest(msg);
+    });
+    if (queued) continue;
     if (inbox_.size() >= kInboxCapacity) {
       send_policy_ack(msg, PolicyReason::loop_busy, "table inbox full: re-send later");
       continue;
     }
     inbox_.push_back(msg);
   }
+}
+
+void EndcapNode::handle_tables(std::int64_t now) {
+  take_tables(*dds_);
+  if (retiring_ != nullptr) take_tables(*retiring_);
   if (in_flight_.active) finish_in_flight(now);
   while (!inbox_.empty()) {
     const PolicyTableMsg incoming = inbox_.front();
@@ -149,7 +163,10 @@ void EndcapNode::send_policy_ack(const PolicyTableMsg& msg, PolicyReason reason,
   ack.active_policy_id(active.policy_id);
   ack.active_policy_version(active.policy_version);
   ack.active_checksum(active.checksum);
+  // On both participants during a rejoin's overlap: which one the host hears is not
+  // known, and an uploader takes the first ack of a sequence and ignores the rest.
   dds_->policy_ack->write(&ack);
+  if (retiring_ != nullptr) retiring_->policy_ack->write(&ack);
   // Transient answers are not repeated to a retry: it is judged again.
   if (reason != PolicyReason::loop_busy && reason != PolicyReason::storage_failed) {
     last_answer_ = LastAnswer{true, msg.upload_sequence(), policy_digest(msg), reason, text};

@@ -21,8 +21,11 @@
 #include "ground/command.hpp"
 #include "ground/keystore.hpp"
 #include "ground/station.hpp"
+#include "ground/upload.hpp"
 #include "msgs/dds.hpp"
 #include "msgs/security.hpp"
+#include "sim/policy.hpp"
+#include "sim/robot.hpp"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "tests/ground/subprocess.hpp"
 
@@ -146,6 +149,24 @@ void estop_lands(Station& station, const EndcapRejoin& t, const char* when) {
   EXPECT_LT(estop.results[0].latency_s, 0.5);
 }
 
+// A table uploaded while both participants listen reaches both (or, on a link
+// stalled one way, only the old one): it is acked and handed to the loop once.
+void upload_lands_once(Station& station, const EndcapRejoin& t) {
+  const fs::path file = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
+  const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(file));
+  auto tables = policy_messages(sim::load_policy(file, robot), robot,
+                                fw::comms::PolicyIdentity{"overlap_gait", 1, robot.name, false}, random_sequence_base());
+  std::erase_if(tables, [](const auto& m) { return m.target_endcap() != kEndcap; });
+  const UploadReport report = upload(station, tables, UploadOptions{});
+  EXPECT_TRUE(report.all_accepted()) << format_upload_report(report) << t.log();
+  std::this_thread::sleep_for(std::chrono::seconds(1));  // a second copy, if any, has arrived
+  const std::string text = t.log();
+  constexpr const char* kAccepted = "policy overlap_gait v1 accepted";
+  EXPECT_NE(text.find(kAccepted), std::string::npos) << text;
+  EXPECT_EQ(text.find(kAccepted), text.rfind(kAccepted)) << text;
+  EXPECT_EQ(text.find("rejected"), std::string::npos) << text;
+}
+
 // Both tests below: a host that hears others but not end cap 3 makes it join again,
 // after the wait and then after twice the wait; a station beside it then hears the new
 // participant (which no longer rejoins) and its emergency stop lands.
@@ -168,11 +189,12 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   ASSERT_TRUE(t.wait_for_rejoins(2, std::chrono::seconds(40))) << t.log();
   EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 2 * kRejoinS - 0.5);
 
-  // Two participants listen now (the old one until a host names the new one): an
-  // emergency stop from a station that names nobody, and so retires nothing, lands
-  // on them once and in bounded time.
+  // Two participants listen now (the old one until a host names the new one): a
+  // policy upload and an emergency stop from a station that names nobody, and so
+  // retires nothing, land on them once and in bounded time.
   {
     Station silent(station_options(domain, "rejoin_test_silent_station", enclave(msgs::Role::ground, -1), false));
+    upload_lands_once(silent, t);
     estop_lands(silent, t, "while two participants listen");
     EXPECT_EQ(t.log().find(kRetireLine), std::string::npos) << t.log();
   }
@@ -225,6 +247,31 @@ TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsPart
   // The control: without it, the same deaf host makes the end cap join again.
   hearing.name(kOthers);
   EXPECT_TRUE(wait_for_rejoins(1, std::chrono::seconds(20))) << log();
+}
+
+// The wait doubles while a deaf host goes unanswered (above), so that it cannot make
+// the end cap churn. A host that is lost and then heard again (restarted, or another
+// one) is not known to be that host: it gets the first wait, not the grown one.
+TEST_F(EndcapRejoin, AHostHeardAgainAfterALossGetsTheFirstWait) {
+  constexpr int kDomain = 197;
+  start_node(kDomain);
+  {
+    NamingHost deaf(kDomain, kOthers);
+    // After kRejoinS, then 2 x kRejoinS: the next wait would be 4 x kRejoinS.
+    ASSERT_TRUE(wait_for_rejoins(2, std::chrono::seconds(40))) << log();
+  }
+  const auto gone = std::chrono::steady_clock::now();
+  while (log().find("host LOST") == std::string::npos &&
+         std::chrono::steady_clock::now() - gone < std::chrono::seconds(10)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_NE(log().find("host LOST"), std::string::npos) << log();
+  const auto back = std::chrono::steady_clock::now();
+  NamingHost deaf_again(kDomain, kOthers);
+  ASSERT_TRUE(wait_for_rejoins(3, std::chrono::seconds(40))) << log();
+  const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - back).count();
+  EXPECT_GE(waited_s, kRejoinS - 0.5);
+  EXPECT_LT(waited_s, 4 * kRejoinS - 2.0) << log();  // the grown wait, less a discovery's margin
 }
 
 // A hung control loop withholds the end cap's heartbeat on purpose (the host must
