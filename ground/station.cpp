@@ -104,7 +104,7 @@ std::int64_t Station::now_ns() {
 
 Station::Station(const StationOptions& options) : options_(options), dds_(std::make_unique<Dds>()) {
   Dds& d = *dds_;
-  d.participant = msgs::create_participant(options.domain, options.name, nullptr, options.enclave_dir, &d.writers);
+  d.participant = msgs::create_participant(options.domain, options.name, {}, options.enclave_dir, &d.writers);
   d.publisher = d.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   // Every end cap's reports, each from its own partition (msgs/endcap_writers.hpp).
   d.subscriber = d.participant->create_subscriber(msgs::endcap_reports_qos());

@@ -50,7 +50,7 @@ void load_qos_profiles() {
   if (!error.empty()) throw DdsError(error);
 }
 
-dds::DomainParticipant* create_participant(int domain, const std::string& name, const std::atomic<bool>* link_cut,
+dds::DomainParticipant* create_participant(int domain, const std::string& name, const LinkFaults& faults,
                                            const std::filesystem::path& enclave_dir,
                                            dds::DomainParticipantListener* listener) {
   load_qos_profiles();
@@ -61,8 +61,10 @@ dds::DomainParticipant* create_participant(int domain, const std::string& name, 
   }
   qos.name(name);
   if (!enclave_dir.empty()) apply_security(qos, enclave_files(enclave_dir));
-  if (link_cut != nullptr) {
-    for (auto& transport : qos.transport().user_transports) transport = make_link_cut_transport(transport, link_cut);
+  if (faults.cut != nullptr || faults.mute != nullptr) {
+    for (auto& transport : qos.transport().user_transports) {
+      transport = make_link_cut_transport(transport, faults.cut, faults.mute);
+    }
   }
   dds::DomainParticipant* participant =
       factory->create_participant(static_cast<dds::DomainId_t>(domain), qos, listener, dds::StatusMask::none());

@@ -88,14 +88,17 @@ void load_qos_profiles();
 // With `enclave_dir` (a keystore's enclave folder, msgs/security.hpp) the DDS
 // Security plugins authenticate it and enforce the enclave's permissions; empty:
 // an unsecured participant, which a secured one never talks to.
-// Delete with delete_participant (deletes its entities first). With `link_cut`,
-// its transport drops every datagram in and out while *link_cut is true (fault
-// injection: msgs/link_cut_transport.hpp); the flag must outlive the participant.
+// Delete with delete_participant (deletes its entities first). With `faults`, its
+// transport drops datagrams while a fault's flag is set (fault injection:
+// msgs/link_cut_transport.hpp); the flags must outlive the participant.
 // `listener` (e.g. msgs::EndcapWriters) hears discovery from the first datagram on
 // (no status callbacks: the readers' own listeners keep those); it must outlive it.
+struct LinkFaults {
+  const std::atomic<bool>* cut = nullptr;   // while true: nothing in or out (a lost link)
+  const std::atomic<bool>* mute = nullptr;  // while true: nothing out; it still hears
+};
 eprosima::fastdds::dds::DomainParticipant* create_participant(
-    int domain, const std::string& name, const std::atomic<bool>* link_cut = nullptr,
-    const std::filesystem::path& enclave_dir = {},
+    int domain, const std::string& name, const LinkFaults& faults = {}, const std::filesystem::path& enclave_dir = {},
     eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
 void delete_participant(eprosima::fastdds::dds::DomainParticipant* participant) noexcept;
 

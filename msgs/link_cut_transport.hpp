@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // A UDP transport that can be cut: while the flag it watches is set, every RTPS
 // datagram this participant would send is discarded and every one it receives is
-// dropped before Fast DDS sees it. Both directions, so the participant experiences
+// dropped before Fast DDS sees it (or, muted, only the ones it sends). Both
+// directions, so the participant experiences
 // what a lost Wi-Fi link does to it (no heartbeats, no acks, no data, in or out),
 // with nothing changed outside the process: this kernel has no netem, and filtering
 // in the transport keeps the fault local to the one end cap it is injected into.
@@ -14,11 +15,15 @@
 
 namespace tensegrity::msgs {
 
-// Wraps `low_level` (the profile's UDPv4 descriptor). `cut` must outlive the
-// participant; it is read on every datagram (relaxed atomic load: a cut takes
-// effect within one datagram, no ordering with other data is needed). Setting it
+// Wraps `low_level` (the profile's UDPv4 descriptor). While *cut is true nothing
+// goes out or comes in; while *mute is true nothing goes out, and what comes in is
+// delivered: one direction lost, as a security handshake stalled one way leaves a
+// participant (docs/security.md). Either may be null (never). Each must outlive the
+// participant; it is read on every datagram (relaxed atomic load: a fault takes
+// effect within one datagram, no ordering with other data is needed). Setting one
 // from a signal handler is fine (lock-free atomic<bool>).
 std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> make_link_cut_transport(
-    std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> low_level, const std::atomic<bool>* cut);
+    std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> low_level, const std::atomic<bool>* cut,
+    const std::atomic<bool>* mute = nullptr);
 
 }  // namespace tensegrity::msgs

@@ -77,7 +77,7 @@ LiveBridge::LiveBridge(const sim::Robot& robot, const LiveOptions& options, Even
     : robot_(robot), options_(options), hub_(hub), dds_(std::make_unique<Dds>()) {
   // Through msgs::create_participant, like every participant of the project: the
   // same transport, QoS profiles and (where configured) security.
-  dds_->participant = msgs::create_participant(options.domain, "view", nullptr, options.enclave_dir, &dds_->writers);
+  dds_->participant = msgs::create_participant(options.domain, "view", {}, options.enclave_dir, &dds_->writers);
   dds::Subscriber* subscriber = dds_->participant->create_subscriber(msgs::endcap_reports_qos());
   if (subscriber == nullptr) throw msgs::DdsError("view: cannot create a subscriber");
   for (bool telemetry : {true, false}) {

@@ -68,8 +68,9 @@ void EndcapNode::start() {
 
 std::unique_ptr<EndcapNode::Dds> EndcapNode::make_dds() {
   auto d = std::make_unique<Dds>();
-  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id),
-                                            config_.link_cut, config_.enclave_dir);
+  const msgs::LinkFaults faults{config_.link_cut, config_.mute_participant != nullptr ? &d->muted : nullptr};
+  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), faults,
+                                            config_.enclave_dir);
   // Reports go out in this end cap's own partition, the only one its identity may
   // write in (msgs/endcap_writers.hpp); orders come in the default one.
   d->publisher = d->participant->create_publisher(msgs::endcap_publisher_qos(config_.endcap_id));
@@ -181,6 +182,7 @@ void EndcapNode::run() {
 
 void EndcapNode::service(std::int64_t now) {
   report_link_cut();
+  apply_mute_fault();
   StampedTelemetry t;
   if (telemetry_in_.read(t)) {
     last_telemetry_ = t;

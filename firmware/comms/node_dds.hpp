@@ -10,6 +10,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 
+#include <atomic>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -66,8 +67,9 @@ struct EndcapNode::Dds {
   // arriving while the node stopped reached through a half-destroyed object
   // (seen: SIGSEGV at exit).
   std::mutex callback_mutex;
-  bool closed = false;    // guarded by callback_mutex
-  bool retiring = false;  // replaced by a new participant, still listening; guarded by callback_mutex
+  std::atomic<bool> muted{false};  // fault injection: its transport sends nothing (EndcapNodeConfig)
+  bool closed = false;             // guarded by callback_mutex
+  bool retiring = false;           // replaced by a new participant, still listening; guarded by callback_mutex
 
   ~Dds() { close(); }
   void close() noexcept {

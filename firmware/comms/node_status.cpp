@@ -43,6 +43,18 @@ void EndcapNode::report_link_cut() {
   log("DDS link %s (fault injection)", cut ? "CUT" : "restored");
 }
 
+// Only the participant of the moment is muted: the fault is a stalled handshake,
+// which belongs to a participant, not to the link.
+void EndcapNode::apply_mute_fault() {
+  if (config_.mute_participant == nullptr) return;
+  const bool raised = config_.mute_participant->load(std::memory_order_relaxed);
+  if (raised == mute_was_raised_) return;
+  mute_was_raised_ = raised;
+  if (!raised) return;
+  dds_->muted.store(true, std::memory_order_relaxed);
+  log("DDS participant MUTED (fault injection): it hears the host, nothing it sends arrives");
+}
+
 void EndcapNode::check_host_loss(std::int64_t now) {
   const bool lost = host_seen_ && now - last_host_heartbeat_ns_ > std::llround(config_.host_timeout_s * 1e9);
   if (lost == host_lost_.load()) return;

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <thread>
 
 #include "ground/command.hpp"
@@ -46,7 +47,7 @@ constexpr const char* kRetireLine = "the old one closed";
 class NamingHost {
  public:
   NamingHost(int domain, std::uint16_t names, const fs::path& enclave_dir = {}) : names_(names) {
-    participant_ = msgs::create_participant(domain, "naming_host", nullptr, enclave_dir);
+    participant_ = msgs::create_participant(domain, "naming_host", {}, enclave_dir);
     auto* pub = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
     writer_ = msgs::create_writer(*participant_, *pub, msgs::kHostHeartbeatTopic,
                                   dds::TypeSupport(new msg::Heartbeat_PubSubType()));
@@ -154,8 +155,9 @@ void estop_lands(Station& station, const EndcapRejoin& t, const char* when) {
 void upload_lands_once(Station& station, const EndcapRejoin& t) {
   const fs::path file = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
   const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(file));
-  auto tables = policy_messages(sim::load_policy(file, robot), robot,
-                                fw::comms::PolicyIdentity{"overlap_gait", 1, robot.name, false}, random_sequence_base());
+  auto tables =
+      policy_messages(sim::load_policy(file, robot), robot,
+                      fw::comms::PolicyIdentity{"overlap_gait", 1, robot.name, false}, random_sequence_base());
   std::erase_if(tables, [](const auto& m) { return m.target_endcap() != kEndcap; });
   const UploadReport report = upload(station, tables, UploadOptions{});
   EXPECT_TRUE(report.all_accepted()) << format_upload_report(report) << t.log();
@@ -247,6 +249,56 @@ TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsPart
   // The control: without it, the same deaf host makes the end cap join again.
   hearing.name(kOthers);
   EXPECT_TRUE(wait_for_rejoins(1, std::chrono::seconds(20))) << log();
+}
+
+// A one-way stall made, not forged: S seconds in, end cap 3's participant stops
+// sending (comms_test_node --dds-mute-after-s: its transport drops what it sends)
+// and still hears. A real station, which hears end cap 2 beside it, stops naming it;
+// end cap 3 joins again, the station hears it again and the old participant closes.
+// An emergency stop sent while it is muted is acted on at once (it still hears) and
+// acked once the new participant speaks.
+TEST_F(EndcapRejoin, AMutedEndcapJoinsAgainAndIsHeardAgain) {
+  constexpr int kDomain = 199;
+  start_node(kDomain, {}, {"--dds-mute-after-s", "4"});
+  Subprocess other({COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", "2"}, dir_ / "other.out",
+                   dir_ / "other.err");
+  ASSERT_TRUE(other.wait_for_output("READY", std::chrono::seconds(30)));
+  Station station(station_options(kDomain, "rejoin_test_station", {}, true));
+  constexpr std::uint16_t kBoth = (1U << 2) | (1U << kEndcap);
+  ASSERT_TRUE(station.wait_for_endcaps(kBoth, false, Station::now_ns() + 30'000'000'000)) << log();
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while ((station.heard(Station::now_ns(), 1.0) & (1U << kEndcap)) != 0 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_NE(log().find("MUTED"), std::string::npos) << log();
+  ASSERT_EQ(station.heard(Station::now_ns(), 1.0) & kBoth, 1U << 2) << log();
+  ASSERT_EQ(rejoins(), 0) << log();
+
+  auto estop = std::async(std::launch::async, [&station] {
+    CommandOptions c;
+    c.endcap_mask = 1U << kEndcap;
+    c.timeout_s = 30.0;
+    c.retry_interval_s = kEstopRetryIntervalS;
+    return send_command(station, CommandKind::emergency_stop, 0, c);
+  });
+  EXPECT_TRUE(node_->wait_for_output("ESTOPPED", std::chrono::milliseconds(500))) << log();
+  const CommandReport report = estop.get();
+  EXPECT_TRUE(report.all_accepted()) << log();
+  ASSERT_EQ(report.results.size(), 1U);
+  std::printf("estop while muted: acted on at once, acked after %.1f s (rejoin wait %.0f s)\n",
+              report.results[0].latency_s, kRejoinS);
+  EXPECT_GT(report.results[0].latency_s, 1.0);  // not by the muted participant
+  EXPECT_EQ(rejoins(), 1) << log();
+
+  const auto rejoined = std::chrono::steady_clock::now();
+  while (log().find(kRetireLine) == std::string::npos &&
+         std::chrono::steady_clock::now() - rejoined < std::chrono::seconds(15)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_NE(log().find(kRetireLine), std::string::npos) << log();
+  estop_lands(station, *this, "on the end cap that was muted");
+  EXPECT_EQ(rejoins(), 1) << log();
+  EXPECT_EQ(log().find("host LOST"), std::string::npos) << log();
 }
 
 // The wait doubles while a deaf host goes unanswered (above), so that it cannot make

@@ -30,7 +30,7 @@ class RogueTimeServer final : public dds::DataReaderListener {
  public:
   // `enclave_dir`: a DDS Security identity to try the attack with (empty: none).
   explicit RogueTimeServer(int domain, const std::filesystem::path& enclave_dir = {}) {
-    participant_ = msgs::create_participant(domain, "rogue_time_server", nullptr, enclave_dir);
+    participant_ = msgs::create_participant(domain, "rogue_time_server", {}, enclave_dir);
     auto* pub = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
     // Where the end caps' requests are: every end cap's partition.
     auto* sub = participant_->create_subscriber(msgs::endcap_reports_qos());

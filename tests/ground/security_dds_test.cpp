@@ -186,7 +186,7 @@ TEST_F(SecureDds, AnEndcapIdentityCannotGiveOrders) {
 // heartbeat and command-ack writers in end cap 1's own partition.
 struct EndcapOneImpostor {
   explicit EndcapOneImpostor(int domain, const fs::path& enclave_dir)
-      : participant(msgs::create_participant(domain, "impostor", nullptr, enclave_dir)) {}
+      : participant(msgs::create_participant(domain, "impostor", {}, enclave_dir)) {}
   ~EndcapOneImpostor() { msgs::delete_participant(participant); }
   EndcapOneImpostor(const EndcapOneImpostor&) = delete;
   EndcapOneImpostor& operator=(const EndcapOneImpostor&) = delete;

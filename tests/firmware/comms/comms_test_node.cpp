@@ -7,7 +7,7 @@
 //     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
 //     [--stall-commands] [--dds-cut-signals] [--keystore DIR] [--unheard-rejoin-s S]
-//     [--loop-stall-after-s S [--loop-stall-for-s D]]
+//     [--loop-stall-after-s S [--loop-stall-for-s D]] [--dds-mute-after-s S]
 // --stall-commands: the stub loops never take a command from the mailbox (it
 // fills up), but read the emergency-stop counter every cycle.
 // --dds-cut-signals: SIGUSR1 cuts every node's DDS link, SIGUSR2 restores it.
@@ -15,6 +15,8 @@
 // --loop-stall-after-s: the nodes watch a loop-progress counter (as the endcap
 // program's do) that moves until S seconds after the start, then hangs (for good, or
 // for D seconds with --loop-stall-for-s).
+// --dds-mute-after-s: S seconds after the start, each node's participant of that
+// moment stops sending for good and still hears (EndcapNodeConfig::mute_participant).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -41,6 +43,7 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 std::atomic<bool> g_link_cut{false};
+std::atomic<bool> g_mute{false};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
 std::atomic<std::uint64_t> g_loop_progress{0};
 
@@ -84,6 +87,7 @@ int main(int argc, char** argv) {
   bool cut_signals = false;
   double loop_stall_after_s = -1.0;  // never
   double loop_stall_for_s = 1e9;     // for good
+  double mute_after_s = -1.0;        // never
   std::string keystore;
   fw::comms::EndcapNodeConfig base;
   try {
@@ -127,6 +131,8 @@ int main(int argc, char** argv) {
         loop_stall_after_s = std::stod(value());
       else if (arg == "--loop-stall-for-s")
         loop_stall_for_s = std::stod(value());
+      else if (arg == "--dds-mute-after-s")
+        mute_after_s = std::stod(value());
       else
         throw std::invalid_argument("unknown argument " + arg);
     }
@@ -157,6 +163,20 @@ int main(int argc, char** argv) {
         if (now < hang || now >= resume) g_loop_progress.fetch_add(1, std::memory_order_relaxed);
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
+    });
+  }
+
+  std::jthread mute;
+  if (mute_after_s >= 0.0) {
+    base.mute_participant = &g_mute;
+    mute = std::jthread([mute_after_s](const std::stop_token& stop) {
+      const auto at =
+          std::chrono::steady_clock::now() +
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(mute_after_s));
+      while (!stop.stop_requested() && std::chrono::steady_clock::now() < at) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+      g_mute.store(true);
     });
   }
 
