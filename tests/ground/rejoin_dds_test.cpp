@@ -256,23 +256,28 @@ TEST_F(EndcapRejoin, AHostThatHearsNobodyOrAnotherThatHearsTheEndcapKeepsItsPart
 // and still hears. A real station, which hears end cap 2 beside it, stops naming it;
 // end cap 3 joins again, the station hears it again and the old participant closes.
 // An emergency stop sent while it is muted is acted on at once (it still hears) and
-// acked once the new participant speaks.
-TEST_F(EndcapRejoin, AMutedEndcapJoinsAgainAndIsHeardAgain) {
-  constexpr int kDomain = 199;
-  start_node(kDomain, {}, {"--dds-mute-after-s", "4"});
-  Subprocess other({COMMS_TEST_NODE, "--domain", std::to_string(kDomain), "--endcaps", "2"}, dir_ / "other.out",
-                   dir_ / "other.err");
+// acked once the new participant speaks. Secured, the new participant authenticates
+// afresh with the station.
+void muted_joins_again(EndcapRejoin& t, int domain, const fs::path& keystore) {
+  const fs::path station_enclave =
+      keystore.empty() ? fs::path() : msgs::enclave_dir(keystore, msgs::enclave_name(msgs::Role::ground, -1));
+  std::vector<std::string> secured;
+  if (!keystore.empty()) secured = {"--keystore", keystore.string()};
+  t.start_node(domain, keystore, {"--dds-mute-after-s", "4"});
+  std::vector<std::string> argv{COMMS_TEST_NODE, "--domain", std::to_string(domain), "--endcaps", "2"};
+  argv.insert(argv.end(), secured.begin(), secured.end());
+  Subprocess other(argv, t.dir_ / "other.out", t.dir_ / "other.err");
   ASSERT_TRUE(other.wait_for_output("READY", std::chrono::seconds(30)));
-  Station station(station_options(kDomain, "rejoin_test_station", {}, true));
+  Station station(station_options(domain, "rejoin_test_station", station_enclave, true));
   constexpr std::uint16_t kBoth = (1U << 2) | (1U << kEndcap);
-  ASSERT_TRUE(station.wait_for_endcaps(kBoth, false, Station::now_ns() + 30'000'000'000)) << log();
+  ASSERT_TRUE(station.wait_for_endcaps(kBoth, false, Station::now_ns() + 30'000'000'000)) << t.log();
   const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while ((station.heard(Station::now_ns(), 1.0) & (1U << kEndcap)) != 0 && std::chrono::steady_clock::now() < until) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  ASSERT_NE(log().find("MUTED"), std::string::npos) << log();
-  ASSERT_EQ(station.heard(Station::now_ns(), 1.0) & kBoth, 1U << 2) << log();
-  ASSERT_EQ(rejoins(), 0) << log();
+  ASSERT_NE(t.log().find("MUTED"), std::string::npos) << t.log();
+  ASSERT_EQ(station.heard(Station::now_ns(), 1.0) & kBoth, 1U << 2) << t.log();
+  ASSERT_EQ(t.rejoins(), 0) << t.log();
 
   auto estop = std::async(std::launch::async, [&station] {
     CommandOptions c;
@@ -281,24 +286,31 @@ TEST_F(EndcapRejoin, AMutedEndcapJoinsAgainAndIsHeardAgain) {
     c.retry_interval_s = kEstopRetryIntervalS;
     return send_command(station, CommandKind::emergency_stop, 0, c);
   });
-  EXPECT_TRUE(node_->wait_for_output("ESTOPPED", std::chrono::milliseconds(500))) << log();
+  EXPECT_TRUE(t.node_->wait_for_output("ESTOPPED", std::chrono::milliseconds(500))) << t.log();
   const CommandReport report = estop.get();
-  EXPECT_TRUE(report.all_accepted()) << log();
+  EXPECT_TRUE(report.all_accepted()) << t.log();
   ASSERT_EQ(report.results.size(), 1U);
   std::printf("estop while muted: acted on at once, acked after %.1f s (rejoin wait %.0f s)\n",
               report.results[0].latency_s, kRejoinS);
   EXPECT_GT(report.results[0].latency_s, 1.0);  // not by the muted participant
-  EXPECT_EQ(rejoins(), 1) << log();
+  EXPECT_EQ(t.rejoins(), 1) << t.log();
 
   const auto rejoined = std::chrono::steady_clock::now();
-  while (log().find(kRetireLine) == std::string::npos &&
+  while (t.log().find(kRetireLine) == std::string::npos &&
          std::chrono::steady_clock::now() - rejoined < std::chrono::seconds(15)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  EXPECT_NE(log().find(kRetireLine), std::string::npos) << log();
-  estop_lands(station, *this, "on the end cap that was muted");
-  EXPECT_EQ(rejoins(), 1) << log();
-  EXPECT_EQ(log().find("host LOST"), std::string::npos) << log();
+  EXPECT_NE(t.log().find(kRetireLine), std::string::npos) << t.log();
+  estop_lands(station, t, "on the end cap that was muted");
+  EXPECT_EQ(t.rejoins(), 1) << t.log();
+  EXPECT_EQ(t.log().find("host LOST"), std::string::npos) << t.log();
+}
+
+TEST_F(EndcapRejoin, AMutedEndcapJoinsAgainAndIsHeardAgain) { muted_joins_again(*this, 199, {}); }
+
+TEST_F(EndcapRejoin, AMutedSecuredEndcapJoinsAgainAndAuthenticatesAfresh) {
+  create_keystore(dir_ / "keystore");
+  muted_joins_again(*this, 201, dir_ / "keystore");
 }
 
 // The wait doubles while a deaf host goes unanswered (above), so that it cannot make
