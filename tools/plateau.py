@@ -76,11 +76,14 @@ def takeoff(a, curve_csv):
         rows = list(csv.DictReader(f))
     out = {k: None for k in FIELDS[-5:]}
     before = 0.0
-    for r in rows:
-        best = float(r["best_so_far_m"])
+    for line, r in enumerate(rows, start=2):
+        try:
+            best, mean = float(r["best_so_far_m"]), float(r["mean_score_m"])
+        except (KeyError, TypeError, ValueError) as e:
+            sys.exit(f"plateau: {curve_csv}, line {line}: best_so_far_m and mean_score_m must be numbers ({e!r})")
         if best >= a.takeoff_m and out["takeoff_episode"] is None:
             out.update(takeoff_episode=int(r["episodes"]), best_before_takeoff_m=before, best_at_takeoff_m=best,
-                       generation_mean_at_takeoff_m=float(r["mean_score_m"]))
+                       generation_mean_at_takeoff_m=mean)
         if best >= a.roll_m and out["first_roll_episode"] is None:
             out["first_roll_episode"] = int(r["episodes"])
         before = best

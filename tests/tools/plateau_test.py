@@ -66,6 +66,18 @@ class Plateau(unittest.TestCase):
             self.assertEqual(summary["takeoffs"]["median_episodes_takeoff_to_roll"], 50)
             self.assertTrue((out / "plateau.png").stat().st_size > 0)
 
+    def test_a_damaged_curve_is_named(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            arm = pathlib.Path(tmp) / "arm"
+            arm.mkdir()
+            shutil.copy(SOURCE / "robots" / "superball-paper.json", arm / "robot.json")
+            rolling = json.loads((SOURCE / "policies" / "superball-paper-t4-n5.json").read_text())
+            seed(arm, "s1", rolling, [(5, 1), ("lost", 2)])
+            done = subprocess.run(["/usr/bin/python3", str(TOOLS / "plateau.py"), str(arm), "--out", tmp + "/out",
+                                   "--tensegrity", str(TENSEGRITY)], capture_output=True, text=True)
+            self.assertNotEqual(done.returncode, 0)
+            self.assertIn("curve.csv, line 3: best_so_far_m and mean_score_m must be numbers", done.stderr)
+
     def test_a_directory_that_is_not_an_arm_is_named(self):
         with tempfile.TemporaryDirectory() as tmp:
             done = subprocess.run(["/usr/bin/python3", str(TOOLS / "plateau.py"), tmp, "--out", tmp + "/out",
