@@ -32,6 +32,12 @@ class EndcapProcesses {
   // Cuts (up = false) or restores the end cap's DDS link to the host. Returns why
   // it was not done ("" when done): no DDS link in this run, not running, ...
   virtual std::string set_dds_link(int endcap, bool up) = 0;
+  // Its DDS participant of the moment stops sending and still hears (a handshake
+  // stalled one way; the end cap's rejoin clears it). Returns why not ("" when done).
+  virtual std::string mute_dds(int endcap) {
+    (void)endcap;
+    return "not supported by this launcher";
+  }
   // Fault injection: SIGSTOP the program (a dead end cap, nothing of it runs), or
   // with loop_only hang its control loop alone (the test hook --hang-loop-signal).
   // Returns why it was not done ("" when done).

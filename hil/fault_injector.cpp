@@ -30,6 +30,7 @@ void LiveFaultTarget::restart(int endcap) {
 std::string LiveFaultTarget::freeze(int endcap, bool loop_only) { return roster_.freeze(endcap, loop_only); }
 
 std::string LiveFaultTarget::set_dds_link(int endcap, bool up) { return roster_.processes().set_dds_link(endcap, up); }
+std::string LiveFaultTarget::mute_dds(int endcap) { return roster_.processes().mute_dds(endcap); }
 
 void FaultInjector::apply_due(std::int64_t step, std::int64_t now_ns, FaultTarget& target,
                               std::vector<std::string>& log) {
@@ -45,7 +46,8 @@ void FaultInjector::apply(const ScenarioEvent& ev, std::int64_t step, std::int64
   const int e = ev.endcap;
   switch (ev.fault) {
     case FaultKind::cut_dds:
-    case FaultKind::restore_dds: log.push_back(apply_dds_link(ev, target)); return;
+    case FaultKind::restore_dds:
+    case FaultKind::mute_dds: log.push_back(apply_dds_link(ev, target)); return;
     case FaultKind::drive_fault:
     case FaultKind::drive_silent:
     case FaultKind::release_spool:
@@ -125,7 +127,9 @@ std::string FaultInjector::apply_dds_link(const ScenarioEvent& ev, FaultTarget& 
   std::string skipped;
   for (int e = 0; e < target.endcap_count(); ++e) {
     if (ev.endcap >= 0 && e != ev.endcap) continue;
-    const std::string why = target.set_dds_link(e, ev.fault == FaultKind::restore_dds);
+    const std::string why = ev.fault == FaultKind::mute_dds
+                                ? target.mute_dds(e)
+                                : target.set_dds_link(e, ev.fault == FaultKind::restore_dds);
     if (!why.empty()) skipped += (skipped.empty() ? "" : "; ") + ("end cap " + std::to_string(e) + ": " + why);
   }
   return ev.describe() + (skipped.empty() ? "" : ": not done for " + skipped);

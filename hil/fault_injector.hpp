@@ -31,6 +31,8 @@ class FaultTarget {
   virtual void restart(int endcap) = 0;
   // "" when done, else why not (no DDS link in this run, not running, ...).
   virtual std::string set_dds_link(int endcap, bool up) = 0;
+  // Its DDS participant of the moment stops sending (mute_dds). "" when done, else why not.
+  virtual std::string mute_dds(int endcap) = 0;
   // SIGSTOP the program (loop_only: hang its control loop alone); the barrier no
   // longer waits for it. "" when done, else why not.
   virtual std::string freeze(int endcap, bool loop_only) = 0;
@@ -50,6 +52,7 @@ class LiveFaultTarget final : public FaultTarget {
   void kill(int endcap) override;
   void restart(int endcap) override;
   std::string set_dds_link(int endcap, bool up) override;
+  std::string mute_dds(int endcap) override;
   std::string freeze(int endcap, bool loop_only) override;
 
  private:

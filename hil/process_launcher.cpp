@@ -271,6 +271,17 @@ std::string ProcessLauncher::set_dds_link(int e, bool up) {
   return "";
 }
 
+// SIGRTMIN+1: the end cap program's --dds-cut-signals mute (firmware/app/main.cpp).
+std::string ProcessLauncher::mute_dds(int e) {
+  if (!provisioner_.dds_link()) return "this run has no DDS link (provisioner " + provisioner_.name() + ")";
+  reap(e, false);
+  const Slot& s = slots_[e];
+  if (s.pid <= 0) return "not running";
+  if (!catches(s.pid, SIGRTMIN + 1)) return "its program does not handle the mute signal (yet)";
+  if (::kill(s.pid, SIGRTMIN + 1) != 0) return std::string("kill: ") + std::strerror(errno);
+  return "";
+}
+
 std::string ProcessLauncher::freeze(int e, bool loop_only) {
   reap(e, false);
   const Slot& s = slots_[e];

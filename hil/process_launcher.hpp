@@ -76,6 +76,7 @@ class ProcessLauncher final : public EndcapProcesses {
   void restart(int endcap) override;
   // SIGUSR1 (cut) / SIGUSR2 (restore) to a program started with --dds-cut-signals.
   std::string set_dds_link(int endcap, bool up) override;
+  std::string mute_dds(int endcap) override;
   // SIGSTOP, or SIGRTMIN to a program started with --hang-loop-signal (loop_only).
   std::string freeze(int endcap, bool loop_only) override;
 

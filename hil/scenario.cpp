@@ -14,7 +14,7 @@ namespace tensegrity::hil {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 16> kNames{{
+constexpr std::array<std::pair<FaultKind, const char*>, 17> kNames{{
     {FaultKind::drive_fault, "drive_fault"},
     {FaultKind::drive_silent, "drive_silent"},
     {FaultKind::load_cell_stuck, "load_cell_stuck"},
@@ -31,6 +31,7 @@ constexpr std::array<std::pair<FaultKind, const char*>, 16> kNames{{
     {FaultKind::reboot_load_cell, "reboot_load_cell"},
     {FaultKind::hang_loop, "hang_loop"},
     {FaultKind::stop_endcap, "stop_endcap"},
+    {FaultKind::mute_dds, "mute_dds"},
 }};
 
 FaultKind fault_from_name(const std::string& name, const std::string& where) {
@@ -99,6 +100,10 @@ const char* to_string(FaultKind kind) {
   return "unknown";
 }
 
+bool is_dds_link_fault(FaultKind kind) {
+  return kind == FaultKind::cut_dds || kind == FaultKind::restore_dds || kind == FaultKind::mute_dds;
+}
+
 std::string ScenarioEvent::describe() const {
   std::ostringstream s;
   s << "t=" << time_s << " s " << (endcap < 0 ? std::string("all end caps") : "end cap " + std::to_string(endcap))
@@ -161,7 +166,7 @@ Scenario parse_scenario(const std::string& text, int endcap_count, const std::st
     ev.time_s = e["time_s"].get<double>();
     if (!e.contains("fault") || !e["fault"].is_string()) throw HilError(where + ".fault: a string is required");
     ev.fault = fault_from_name(e["fault"].get<std::string>(), where + ".fault");
-    const bool needs_endcap = ev.fault != FaultKind::cut_dds && ev.fault != FaultKind::restore_dds;
+    const bool needs_endcap = !is_dds_link_fault(ev.fault);
     if (e.contains("endcap")) {
       if (!e["endcap"].is_number_integer()) throw HilError(where + ".endcap: an integer");
       ev.endcap = e["endcap"].get<int>();
@@ -213,7 +218,7 @@ ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
   }
   ScenarioEvent ev;
   ev.fault = fault_from_name(text.substr(colon + 1, at - colon - 1), "--fault '" + text + "'");
-  const bool all_allowed = ev.fault == FaultKind::cut_dds || ev.fault == FaultKind::restore_dds;
+  const bool all_allowed = is_dds_link_fault(ev.fault);
   const std::string who = text.substr(0, colon);
   try {
     std::size_t used = 0;

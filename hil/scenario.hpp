@@ -35,9 +35,13 @@ enum class FaultKind : std::uint8_t {
   reboot_load_cell,  // the load cell power-cycles
   hang_loop,         // the end cap's control loop hangs, its process (DDS node) lives (test hook)
   stop_endcap,       // SIGSTOP: a dead end cap; its drives find out through their heartbeat consumer
+  mute_dds,          // the end cap's DDS participant stops sending, for good, and still hears (a handshake
+                     // stalled one way); its rejoin clears it; no endcap: all
 };
 
 const char* to_string(FaultKind kind);
+// cut_dds, restore_dds, mute_dds: faults of the DDS link, which may name every end cap.
+bool is_dds_link_fault(FaultKind kind);
 
 struct FaultParams {
   int motor = 0;                // -1: every motor of the end cap
@@ -54,7 +58,7 @@ struct FaultParams {
 
 struct ScenarioEvent {
   double time_s = 0.0;
-  int endcap = 0;  // -1: every end cap (cut_dds, restore_dds only)
+  int endcap = 0;  // -1: every end cap (DDS link faults only)
   FaultKind fault = FaultKind::drive_fault;
   FaultParams params;
   std::string describe() const;
@@ -68,7 +72,7 @@ struct Scenario {
 Scenario parse_scenario(const std::string& json_text, int endcap_count, const std::string& source = "scenario");
 Scenario load_scenario(const std::filesystem::path& path, int endcap_count);
 // "ENDCAP:FAULT@TIME_S" (params default), e.g. "3:drive_fault@2.0"; ENDCAP "all"
-// for cut_dds and restore_dds.
+// for the DDS link faults.
 ScenarioEvent parse_fault_option(const std::string& text, int endcap_count);
 void sort_events(Scenario& scenario);
 // How a disabled cable fails (tensegrity hil --cable-failure).

@@ -148,6 +148,7 @@ void Endcap::start_host_link() {
       node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
     }
     node_config.link_cut = options_.link_cut;
+    node_config.mute_requests = options_.dds_mute;
     node_config.enclave_dir = enclave_dir();
     node_config.loop_progress = &loop_progress_;
     auto node = std::make_unique<comms::EndcapNode>(node_config, clock_, store_.get());

@@ -41,13 +41,14 @@ struct EndcapOptions {
   double duration_s = 0.0;  // 0: until stopped
   bool no_dds = false;
   std::string host_loss = "continue";
-  double unheard_rejoin_s = 20.0;                // comms::EndcapNodeConfig::unheard_rejoin_s; 0: never
-  int domain = -1;                               // -1: TENSEGRITY_DOMAIN or the default
-  std::filesystem::path keystore;                // --keystore: overrides the config's dds_keystore
-  bool insecure = false;                         // --insecure: DDS without security, explicitly
-  const std::atomic<bool>* link_cut = nullptr;   // --dds-cut-signals
-  const std::atomic<bool>* hang_loop = nullptr;  // --hang-loop-signal (HIL tests only)
-  std::filesystem::path stats_path;              // --stats-json: a snapshot every second while running
+  double unheard_rejoin_s = 20.0;                        // comms::EndcapNodeConfig::unheard_rejoin_s; 0: never
+  int domain = -1;                                       // -1: TENSEGRITY_DOMAIN or the default
+  std::filesystem::path keystore;                        // --keystore: overrides the config's dds_keystore
+  bool insecure = false;                                 // --insecure: DDS without security, explicitly
+  const std::atomic<bool>* link_cut = nullptr;           // --dds-cut-signals
+  const std::atomic<std::uint32_t>* dds_mute = nullptr;  // --dds-cut-signals: each one mutes the participant
+  const std::atomic<bool>* hang_loop = nullptr;          // --hang-loop-signal (HIL tests only)
+  std::filesystem::path stats_path;                      // --stats-json: a snapshot every second while running
 };
 
 // The identity `endcap --policy FILE` stores with the file's table: named after

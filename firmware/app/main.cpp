@@ -7,6 +7,7 @@
 // its own.
 #include <atomic>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -23,9 +24,13 @@ std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
 // HIL fault injection (--dds-cut-signals): SIGUSR1 cuts the DDS link, SIGUSR2
-// restores it. A lock-free atomic store is all a handler may do; the node logs it.
+// restores it, SIGRTMIN+1 mutes the participant of the moment (a handshake stalled
+// one way, which the node's rejoin clears). A lock-free atomic is all a handler may
+// touch; the node logs it.
 std::atomic<bool> g_link_cut{false};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
+std::atomic<std::uint32_t> g_dds_mutes{0};
+extern "C" void on_mute_signal(int) { g_dds_mutes.fetch_add(1); }
 
 // HIL fault injection, tests only (--hang-loop-signal): SIGRTMIN hangs the control
 // loop for good (no cycle, no CAN heartbeat); the process and its DDS node live on.
@@ -96,7 +101,8 @@ int main(int argc, char** argv) {
       ->excludes(keystore_opt);
   cli.add_flag(
       "--dds-cut-signals", cut_signals,
-      "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it");
+      "fault injection (HIL): SIGUSR1 cuts the DDS link (every datagram in and out dropped), SIGUSR2 restores it; "
+      "SIGRTMIN+1 mutes the DDS participant of the moment (it hears, nothing it sends arrives; a rejoin clears it)");
   cli.add_flag("--hang-loop-signal", hang_signal,
                "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
   CLI11_PARSE(cli, argc, argv);
@@ -104,7 +110,9 @@ int main(int argc, char** argv) {
   if (cut_signals) {
     std::signal(SIGUSR1, on_link_signal);
     std::signal(SIGUSR2, on_link_signal);
+    std::signal(SIGRTMIN + 1, on_mute_signal);
     o.link_cut = &g_link_cut;
+    o.dds_mute = &g_dds_mutes;
   }
   if (hang_signal) {
     std::signal(SIGRTMIN, on_hang_signal);

@@ -68,7 +68,7 @@ void EndcapNode::start() {
 
 std::unique_ptr<EndcapNode::Dds> EndcapNode::make_dds() {
   auto d = std::make_unique<Dds>();
-  const msgs::LinkFaults faults{config_.link_cut, config_.mute_participant != nullptr ? &d->muted : nullptr};
+  const msgs::LinkFaults faults{config_.link_cut, config_.mute_requests != nullptr ? &d->muted : nullptr};
   d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), faults,
                                             config_.enclave_dir);
   // Reports go out in this end cap's own partition, the only one its identity may

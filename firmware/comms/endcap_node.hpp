@@ -127,6 +127,7 @@ class EndcapNode final : public app::HostLink {
   // node_rejoin.cpp
   void note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now_ns);
   void check_heard(std::int64_t now_ns);
+  void note_host_lost();
   void rejoin();
   void retire() noexcept;
   // node_time_sync.cpp
@@ -186,7 +187,7 @@ class EndcapNode final : public app::HostLink {
   std::int64_t next_unsynced_report_ns_ = 0;
   std::uint64_t refused_format_ = 0;
   bool link_was_cut_ = false;
-  bool mute_was_raised_ = false;
+  std::uint32_t mutes_seen_ = 0;
   std::uint64_t loop_progress_seen_ = 0;
   std::int64_t loop_progress_ns_ = 0;  // node clock when the counter last moved
   bool loop_stall_reported_ = false;

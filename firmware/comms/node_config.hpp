@@ -45,11 +45,11 @@ struct EndcapNodeConfig {
   // Fault injection (HIL): while *link_cut is true the participant's transport
   // drops every datagram in and out (msgs/link_cut_transport.hpp). Null: never cut.
   const std::atomic<bool>* link_cut = nullptr;
-  // Fault injection (tests): when *mute_participant rises, the participant of that
+  // Fault injection (HIL): each time *mute_requests grows, the participant of that
   // moment sends nothing more, for good, and still hears: the symptom of a security
   // handshake stalled one way (docs/security.md), which a new participant clears
-  // (node_rejoin.cpp). Null: never.
-  const std::atomic<bool>* mute_participant = nullptr;
+  // (node_rejoin.cpp). A counter, so that a signal handler can ask twice. Null: never.
+  const std::atomic<std::uint32_t>* mute_requests = nullptr;
   // Watchdog: the control loop's progress counter (bumped by the loop thread every
   // pass, a lockstep wait for SYNC included). When it stands still for
   // loop_stall_timeout_s the node withholds its heartbeat, so the host sees a hung

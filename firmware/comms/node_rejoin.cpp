@@ -85,6 +85,27 @@ void EndcapNode::check_heard(std::int64_t now) {
   rejoin();
 }
 
+// A host that stops hearing an end cap's participant drops it when its lease runs
+// out (Fast DDS's default: 20 s, as long as the default wait above) and sends it
+// nothing more: the end cap then loses the host, and a lost host is no evidence, so
+// the wait above never ends. If the host's last heartbeats named other end caps but
+// not this one for longer than its window, the loss is this participant's doing: a
+// new one is announced afresh and found again (seen with a participant muted one way,
+// tests/hil/hil_dds_test.cpp). A host that dies while it hears this end cap names it
+// to the end, and the end cap only waits for it.
+void EndcapNode::note_host_lost() {
+  if (config_.unheard_rejoin_s == 0.0 || loop_stall_reported_) return;
+  const std::int64_t last = last_host_heartbeat_ns_;
+  if (last - named_ns_ <= kHostWindowNs || last - others_named_ns_ > kHostWindowNs) return;
+  if (last - participant_since_ns_ <= kHostWindowNs) return;  // too new to have been judged
+  log("host lost after it heard other end caps but not this one for %.0f s: it dropped this participant; "
+      "a new DDS participant (rejoin %llu)",
+      static_cast<double>(last - named_ns_) * 1e-9,
+      static_cast<unsigned long long>(rejoins_.load(std::memory_order_relaxed) + 1));
+  rejoin_wait_s_ = std::min(2.0 * rejoin_wait_s_, kMaxBackoff * config_.unheard_rejoin_s);
+  rejoin();
+}
+
 // On the node thread, the only one that uses dds_. The new participant is made
 // before the old one goes: the stall may be one way only, so the old one can still
 // carry orders in (an emergency stop among them) until the link works both ways on

@@ -46,11 +46,10 @@ void EndcapNode::report_link_cut() {
 // Only the participant of the moment is muted: the fault is a stalled handshake,
 // which belongs to a participant, not to the link.
 void EndcapNode::apply_mute_fault() {
-  if (config_.mute_participant == nullptr) return;
-  const bool raised = config_.mute_participant->load(std::memory_order_relaxed);
-  if (raised == mute_was_raised_) return;
-  mute_was_raised_ = raised;
-  if (!raised) return;
+  if (config_.mute_requests == nullptr) return;
+  const std::uint32_t requests = config_.mute_requests->load(std::memory_order_relaxed);
+  if (requests == mutes_seen_) return;
+  mutes_seen_ = requests;
   dds_->muted.store(true, std::memory_order_relaxed);
   log("DDS participant MUTED (fault injection): it hears the host, nothing it sends arrives");
 }
@@ -63,6 +62,7 @@ void EndcapNode::check_host_loss(std::int64_t now) {
   log("host %s (configured action: %s)", lost ? "LOST: no heartbeat" : "back", to_string(config_.host_loss));
   // A counter the loop reads every cycle, like the estop: never refused by a full mailbox.
   if (lost && config_.host_loss == HostLossAction::stop) host_loss_stops_.fetch_add(1, std::memory_order_acq_rel);
+  if (lost) note_host_lost();  // perhaps our own doing (node_rejoin.cpp)
 }
 
 // The one place that decides whether the control loop is alive, for the heartbeat:

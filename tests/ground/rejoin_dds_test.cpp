@@ -315,7 +315,8 @@ TEST_F(EndcapRejoin, AMutedSecuredEndcapJoinsAgainAndAuthenticatesAfresh) {
 
 // The wait doubles while a deaf host goes unanswered (above), so that it cannot make
 // the end cap churn. A host that is lost and then heard again (restarted, or another
-// one) is not known to be that host: it gets the first wait, not the grown one.
+// one) is not known to be that host: it gets the first wait, not the grown one (and a
+// loss after the host named others but not end cap 3 makes one participant at once).
 TEST_F(EndcapRejoin, AHostHeardAgainAfterALossGetsTheFirstWait) {
   constexpr int kDomain = 197;
   start_node(kDomain);
@@ -323,6 +324,8 @@ TEST_F(EndcapRejoin, AHostHeardAgainAfterALossGetsTheFirstWait) {
     NamingHost deaf(kDomain, kOthers);
     // After kRejoinS, then 2 x kRejoinS: the next wait would be 4 x kRejoinS.
     ASSERT_TRUE(wait_for_rejoins(2, std::chrono::seconds(40))) << log();
+    // Unheard on its new participant too, past the host's 2 s window.
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   }
   const auto gone = std::chrono::steady_clock::now();
   while (log().find("host LOST") == std::string::npos &&
@@ -330,12 +333,37 @@ TEST_F(EndcapRejoin, AHostHeardAgainAfterALossGetsTheFirstWait) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_NE(log().find("host LOST"), std::string::npos) << log();
+  // A host lost after it heard others but not end cap 3 for longer than its window
+  // may have dropped it: one more participant at the loss (note_host_lost).
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const int at_loss = rejoins();
+  EXPECT_EQ(at_loss, 3) << log();
+  EXPECT_NE(log().find("it dropped this participant"), std::string::npos) << log();
   const auto back = std::chrono::steady_clock::now();
   NamingHost deaf_again(kDomain, kOthers);
-  ASSERT_TRUE(wait_for_rejoins(3, std::chrono::seconds(40))) << log();
+  ASSERT_TRUE(wait_for_rejoins(at_loss + 1, std::chrono::seconds(40))) << log();
   const double waited_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - back).count();
   EXPECT_GE(waited_s, kRejoinS - 0.5);
   EXPECT_LT(waited_s, 4 * kRejoinS - 2.0) << log();  // the grown wait, less a discovery's margin
+}
+
+// A host that dies while it hears end cap 3 named it to the end: its loss is no
+// evidence against the end cap, which waits for it with the participant it has.
+TEST_F(EndcapRejoin, AHostThatDiesHearingTheEndcapIsWaitedFor) {
+  constexpr int kDomain = 203;
+  start_node(kDomain);
+  {
+    NamingHost hearing(kDomain, kAllEndcaps);
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+  }
+  const auto gone = std::chrono::steady_clock::now();
+  while (log().find("host LOST") == std::string::npos &&
+         std::chrono::steady_clock::now() - gone < std::chrono::seconds(10)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_NE(log().find("host LOST"), std::string::npos) << log();
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  EXPECT_EQ(rejoins(), 0) << log();
 }
 
 // A hung control loop withholds the end cap's heartbeat on purpose (the host must

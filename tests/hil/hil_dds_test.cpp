@@ -151,6 +151,36 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
               at_cut, at_restore, r.distance_m, ref_m);
 }
 
+// A one-way stall of one end cap's link (mute_dds: its participant stops sending
+// and still hears, as a security handshake stalled one way leaves it): the host
+// stops hearing end cap 5 and, when its lease on it runs out (20 s, Fast DDS's
+// default, on the wall clock, hence real time), stops talking to it. End cap 5 joins
+// again, after its unheard wait (20 s) or at that host loss, whichever comes first,
+// and is heard again; the open-loop gait never knew: all twelve play to the end.
+TEST(HilDds, AMutedEndcapJoinsAgainAndPlaysOn) {
+  TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
+  HilOptions o = options(36.0, Provision::dds);
+  o.mode = StepperMode::realtime;
+  o.policy = evolved_policy_file();
+  ScenarioEvent mute;
+  mute.time_s = 2.0;
+  mute.endcap = 5;
+  mute.fault = FaultKind::mute_dds;
+  o.scenario.events = {mute};
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  for (const auto& e : r.endcaps) {
+    EXPECT_EQ(e.dds_rejoins, e.endcap == 5 ? 1U : 0U) << "end cap " << e.endcap;
+    EXPECT_LE(e.host_losses, e.endcap == 5 ? 1U : 0U) << "end cap " << e.endcap;
+    EXPECT_EQ(e.host_returns, e.host_losses) << "end cap " << e.endcap << " did not hear the host again";
+    EXPECT_EQ(e.fault, "none") << "end cap " << e.endcap;
+  }
+  EXPECT_EQ(r.playing, 12);
+  EXPECT_TRUE(logged(r, "end cap 5", "mute_dds")) << "the scenario's event in the run's log";
+  std::printf("muted end cap 5 at 2 s: rejoined once (host losses %llu), %.3f m in %.0f s\n",
+              static_cast<unsigned long long>(r.endcaps.at(5).host_losses), r.distance_m, o.duration_s);
+}
+
 // The counts travel in each end cap's --stats-json, and a killed program's last
 // snapshot is kept: end cap 4's link cut happened to the incarnation killed after
 // it, and the run's summary still has it.

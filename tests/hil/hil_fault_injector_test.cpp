@@ -33,6 +33,10 @@ class RecordingTarget final : public FaultTarget {
     actions.push_back(std::string(up ? "link up " : "link cut ") + std::to_string(e));
     return e == 1 ? "not running" : "";
   }
+  std::string mute_dds(int e) override {
+    actions.push_back("mute " + std::to_string(e));
+    return "";
+  }
   std::string freeze(int e, bool loop_only) override {
     actions.push_back(std::string(loop_only ? "hang " : "stop ") + std::to_string(e));
     return "";
@@ -93,6 +97,20 @@ TEST(HilFaultInjector, EventsBecomeActionsInTheStepTheyAreDue) {
   EXPECT_TRUE(target.devices(2).summary().load_cell_stuck) << "applied at step 0";
   ASSERT_EQ(log.size(), 6u);
   EXPECT_NE(log[5].find("not done for end cap 1: not running"), std::string::npos) << log[5];
+}
+
+TEST(HilFaultInjector, AMuteReachesTheNamedEndcapOrEveryOne) {
+  Scenario s;
+  s.events = {event(0.002, 2, FaultKind::mute_dds), event(0.004, -1, FaultKind::mute_dds)};
+  FaultInjector injector(s, kDtS);
+  RecordingTarget target;
+  std::vector<std::string> log;
+  const auto by_step = run(injector, target, 5, log);
+  ASSERT_EQ(by_step.size(), 2u);
+  EXPECT_EQ(by_step[0].second, (std::vector<std::string>{"mute 2"}));
+  EXPECT_EQ(by_step[1].second, (std::vector<std::string>{"mute 0", "mute 1", "mute 2"}));
+  ASSERT_EQ(log.size(), 2u);
+  EXPECT_NE(log[0].find("mute_dds"), std::string::npos) << log[0];
 }
 
 TEST(HilFaultInjector, DeviceFaultsReachTheChosenMotors) {

@@ -51,6 +51,9 @@ TEST(HilScenario, FaultOption) {
   EXPECT_THROW(parse_fault_option("3-drive_silent", 12), HilError);
   EXPECT_EQ(parse_fault_option("all:cut_dds@5", 12).endcap, -1);
   EXPECT_EQ(parse_fault_option("4:restore_dds@6.5", 12).endcap, 4);
+  EXPECT_EQ(parse_fault_option("all:mute_dds@5", 12).endcap, -1);
+  EXPECT_EQ(parse_fault_option("7:mute_dds@1", 12).fault, FaultKind::mute_dds);
+  EXPECT_EQ(parse_scenario(R"([{"time_s": 1, "fault": "mute_dds"}])", 12).events.at(0).endcap, -1);
   EXPECT_THROW(parse_fault_option("all:kill_endcap@5", 12), HilError);  // "all" only for the link
   EXPECT_THROW(parse_fault_option("3:kill_endcap@5x", 12), HilError);
 }

@@ -16,7 +16,7 @@
 // program's do) that moves until S seconds after the start, then hangs (for good, or
 // for D seconds with --loop-stall-for-s).
 // --dds-mute-after-s: S seconds after the start, each node's participant of that
-// moment stops sending for good and still hears (EndcapNodeConfig::mute_participant).
+// moment stops sending for good and still hears (EndcapNodeConfig::mute_requests).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -43,7 +43,7 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 std::atomic<bool> g_link_cut{false};
-std::atomic<bool> g_mute{false};
+std::atomic<std::uint32_t> g_mute_requests{0};
 extern "C" void on_link_signal(int signal) { g_link_cut.store(signal == SIGUSR1); }
 std::atomic<std::uint64_t> g_loop_progress{0};
 
@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
 
   std::jthread mute;
   if (mute_after_s >= 0.0) {
-    base.mute_participant = &g_mute;
+    base.mute_requests = &g_mute_requests;
     mute = std::jthread([mute_after_s](const std::stop_token& stop) {
       const auto at =
           std::chrono::steady_clock::now() +
@@ -176,7 +176,7 @@ int main(int argc, char** argv) {
       while (!stop.stop_requested() && std::chrono::steady_clock::now() < at) {
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
       }
-      g_mute.store(true);
+      if (!stop.stop_requested()) g_mute_requests.fetch_add(1);
     });
   }
 
