@@ -53,6 +53,34 @@ void report_exit(const app::Endcap& endcap, const std::string& stats_path) {
   if (!stats_path.empty() && !app::write_stats(stats_path, s)) app::log_line("could not write %s", stats_path.c_str());
 }
 
+// The node's rule (comms::validate): a wait shorter than a host's 2 s hearing window churns.
+CLI::Validator rejoin_wait_validator() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        double s = -1.0;
+        try {
+          s = std::stod(text);
+        } catch (const std::exception&) {
+        }
+        return s == 0.0 || (s >= 3.0 && s <= 3600.0) ? "" : "expected 0 (never) or 3..3600 s, got " + text;
+      },
+      "0 or 3..3600");
+}
+
+void install_fault_hooks(bool cut_signals, bool hang_signal, app::EndcapOptions& o) {
+  if (cut_signals) {
+    std::signal(SIGUSR1, on_link_signal);
+    std::signal(SIGUSR2, on_link_signal);
+    std::signal(SIGRTMIN + 1, on_mute_signal);
+    o.link_cut = &g_link_cut;
+    o.dds_mute = &g_dds_mutes;
+  }
+  if (hang_signal) {
+    std::signal(SIGRTMIN, on_hang_signal);
+    o.hang_loop = &g_hang_loop;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,17 +108,7 @@ int main(int argc, char** argv) {
   cli.add_option("--unheard-rejoin-s", o.unheard_rejoin_s,
                  "hearing hosts that hear other end caps but not this one for this long, make a new DDS participant "
                  "(a stalled security handshake; the wait doubles while unanswered, up to 8x); 0: never")
-      ->check(CLI::Validator(
-          [](const std::string& text) -> std::string {
-            // The node's rule (comms::validate): a wait shorter than a host's 2 s hearing window churns.
-            double s = -1.0;
-            try {
-              s = std::stod(text);
-            } catch (const std::exception&) {
-            }
-            return s == 0.0 || (s >= 3.0 && s <= 3600.0) ? "" : "expected 0 (never) or 3..3600 s, got " + text;
-          },
-          "0 or 3..3600"))
+      ->check(rejoin_wait_validator())
       ->capture_default_str();
   cli.add_option("--domain", o.domain, "DDS domain id (default: TENSEGRITY_DOMAIN or 42)")->check(CLI::Range(0, 232));
   std::string keystore;
@@ -106,18 +124,7 @@ int main(int argc, char** argv) {
   cli.add_flag("--hang-loop-signal", hang_signal,
                "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
   CLI11_PARSE(cli, argc, argv);
-  // First thing: a SIGUSR1 that arrived before the handler would end the program.
-  if (cut_signals) {
-    std::signal(SIGUSR1, on_link_signal);
-    std::signal(SIGUSR2, on_link_signal);
-    std::signal(SIGRTMIN + 1, on_mute_signal);
-    o.link_cut = &g_link_cut;
-    o.dds_mute = &g_dds_mutes;
-  }
-  if (hang_signal) {
-    std::signal(SIGRTMIN, on_hang_signal);
-    o.hang_loop = &g_hang_loop;
-  }
+  install_fault_hooks(cut_signals, hang_signal, o);  // first thing: a SIGUSR1 before its handler ends the program
   o.config_path = config_path;
   o.keystore = keystore;
   o.policy_path = policy_path;
