@@ -128,6 +128,7 @@ class EndcapNode final : public app::HostLink {
   void note_host_heartbeat(std::uint16_t heard_endcaps, std::int64_t now_ns);
   void check_heard(std::int64_t now_ns);
   void note_host_lost();
+  void rejoin_unheard(const char* what, std::int64_t unheard_ns, const char* then);
   void rejoin();
   void retire() noexcept;
   // node_time_sync.cpp

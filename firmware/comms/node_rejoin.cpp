@@ -77,9 +77,12 @@ void EndcapNode::check_heard(std::int64_t now) {
   if (now - others_named_ns_ > kHostWindowNs) return;
   const std::int64_t since = std::max({named_ns_, hearing_since_ns_, others_named_since_ns_, participant_since_ns_});
   if (now - since < to_ns(rejoin_wait_s_)) return;
-  log("hearing the host, which hears other end caps, but not heard by it for %.0f s: a new DDS participant "
-      "(rejoin %llu)",
-      static_cast<double>(now - since) * 1e-9,
+  rejoin_unheard("hearing the host, which hears other end caps, but not heard by it", now - since, "");
+}
+
+// Both ways of finding this end cap unheard: said, and the next wait doubled.
+void EndcapNode::rejoin_unheard(const char* what, std::int64_t unheard_ns, const char* then) {
+  log("%s for %.0f s%s: a new DDS participant (rejoin %llu)", what, static_cast<double>(unheard_ns) * 1e-9, then,
       static_cast<unsigned long long>(rejoins_.load(std::memory_order_relaxed) + 1));
   rejoin_wait_s_ = std::min(2.0 * rejoin_wait_s_, kMaxBackoff * config_.unheard_rejoin_s);
   rejoin();
@@ -98,12 +101,8 @@ void EndcapNode::note_host_lost() {
   const std::int64_t last = last_host_heartbeat_ns_;
   if (last - named_ns_ <= kHostWindowNs || last - others_named_ns_ > kHostWindowNs) return;
   if (last - participant_since_ns_ <= kHostWindowNs) return;  // too new to have been judged
-  log("host lost after it heard other end caps but not this one for %.0f s: it dropped this participant; "
-      "a new DDS participant (rejoin %llu)",
-      static_cast<double>(last - named_ns_) * 1e-9,
-      static_cast<unsigned long long>(rejoins_.load(std::memory_order_relaxed) + 1));
-  rejoin_wait_s_ = std::min(2.0 * rejoin_wait_s_, kMaxBackoff * config_.unheard_rejoin_s);
-  rejoin();
+  rejoin_unheard("host lost after it heard other end caps but not this one", last - named_ns_,
+                 "; it dropped this participant");
 }
 
 // On the node thread, the only one that uses dds_. The new participant is made

@@ -112,6 +112,15 @@ class EndcapRejoin : public ::testing::Test {
     for (auto at = text.find(kRejoinLine); at != std::string::npos; at = text.find(kRejoinLine, at + 1)) ++n;
     return n;
   }
+  // Whether `line` is in the node's log within `timeout_s`.
+  bool wait_for_line(const std::string& line, double timeout_s) const {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (log().find(line) == std::string::npos) {
+      if (std::chrono::steady_clock::now() > until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return true;
+  }
   bool wait_for_rejoins(int n, std::chrono::seconds timeout) const {
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (rejoins() < n) {
@@ -207,12 +216,7 @@ void joins_again_and_obeys(EndcapRejoin& t, int domain, const fs::path& keystore
   ASSERT_TRUE(station.wait_for_endcaps(1U << kEndcap, false, Station::now_ns() + 30'000'000'000)) << t.log();
   // Named by the station (past the host's 2 s window), the new one is known to be
   // heard: the old one closes, once.
-  const auto named = std::chrono::steady_clock::now();
-  while (t.log().find(kRetireLine) == std::string::npos &&
-         std::chrono::steady_clock::now() - named < std::chrono::seconds(10)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  EXPECT_NE(t.log().find(kRetireLine), std::string::npos) << t.log();
+  EXPECT_TRUE(t.wait_for_line(kRetireLine, 10.0)) << t.log();
   estop_lands(station, t, "on the rejoined end cap");
   const int after = t.rejoins();
   std::this_thread::sleep_for(std::chrono::duration<double>(3 * kRejoinS));
@@ -295,12 +299,7 @@ void muted_joins_again(EndcapRejoin& t, int domain, const fs::path& keystore) {
   EXPECT_GT(report.results[0].latency_s, 1.0);  // not by the muted participant
   EXPECT_EQ(t.rejoins(), 1) << t.log();
 
-  const auto rejoined = std::chrono::steady_clock::now();
-  while (t.log().find(kRetireLine) == std::string::npos &&
-         std::chrono::steady_clock::now() - rejoined < std::chrono::seconds(15)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  EXPECT_NE(t.log().find(kRetireLine), std::string::npos) << t.log();
+  EXPECT_TRUE(t.wait_for_line(kRetireLine, 15.0)) << t.log();
   estop_lands(station, t, "on the end cap that was muted");
   EXPECT_EQ(t.rejoins(), 1) << t.log();
   EXPECT_EQ(t.log().find("host LOST"), std::string::npos) << t.log();
@@ -327,12 +326,7 @@ TEST_F(EndcapRejoin, AHostHeardAgainAfterALossGetsTheFirstWait) {
     // Unheard on its new participant too, past the host's 2 s window.
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));
   }
-  const auto gone = std::chrono::steady_clock::now();
-  while (log().find("host LOST") == std::string::npos &&
-         std::chrono::steady_clock::now() - gone < std::chrono::seconds(10)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_NE(log().find("host LOST"), std::string::npos) << log();
+  ASSERT_TRUE(wait_for_line("host LOST", 10.0)) << log();
   // A host lost after it heard others but not end cap 3 for longer than its window
   // may have dropped it: one more participant at the loss (note_host_lost).
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -356,12 +350,7 @@ TEST_F(EndcapRejoin, AHostThatDiesHearingTheEndcapIsWaitedFor) {
     NamingHost hearing(kDomain, kAllEndcaps);
     std::this_thread::sleep_for(std::chrono::seconds(3));
   }
-  const auto gone = std::chrono::steady_clock::now();
-  while (log().find("host LOST") == std::string::npos &&
-         std::chrono::steady_clock::now() - gone < std::chrono::seconds(10)) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_NE(log().find("host LOST"), std::string::npos) << log();
+  ASSERT_TRUE(wait_for_line("host LOST", 10.0)) << log();
   std::this_thread::sleep_for(std::chrono::seconds(2));
   EXPECT_EQ(rejoins(), 0) << log();
 }
@@ -376,15 +365,8 @@ TEST_F(EndcapRejoin, AnEndcapWhoseLoopHungKeepsItsParticipant) {
   constexpr double kHangS = 10.0;  // more than 3 waits
   start_node(kDomain, {}, {"--loop-stall-after-s", "0.5", "--loop-stall-for-s", std::to_string(kHangS)});
   NamingHost deaf(kDomain, kOthers);
-  auto wait_for = [this](const char* line, double s) {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
-    while (log().find(line) == std::string::npos && std::chrono::steady_clock::now() < until) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return log().find(line) != std::string::npos;
-  };
-  ASSERT_TRUE(wait_for("control loop STALLED", 5.0)) << log();
-  ASSERT_TRUE(wait_for("control loop progressing again", kHangS + 5.0)) << log();
+  ASSERT_TRUE(wait_for_line("control loop STALLED", 5.0)) << log();
+  ASSERT_TRUE(wait_for_line("control loop progressing again", kHangS + 5.0)) << log();
   EXPECT_EQ(rejoins(), 0) << log();
   const auto resumed = std::chrono::steady_clock::now();
   ASSERT_TRUE(wait_for_rejoins(1, std::chrono::seconds(15))) << log();

@@ -28,13 +28,18 @@ def seed(arm, name, policy, bests_and_means):
     (run / "curve.csv").write_text(HEADER + "".join(rows))
 
 
+def make_arm(tmp):
+    """An arm directory with the default robot, and the shipped rolling gait."""
+    arm = pathlib.Path(tmp) / "arm"
+    arm.mkdir()
+    shutil.copy(SOURCE / "robots" / "superball-paper.json", arm / "robot.json")
+    return arm, json.loads((SOURCE / "policies" / "superball-paper-t4-n5.json").read_text())
+
+
 class Plateau(unittest.TestCase):
     def test_a_rolling_seed_and_a_still_one(self):
         with tempfile.TemporaryDirectory() as tmp:
-            arm = pathlib.Path(tmp) / "arm"
-            arm.mkdir()
-            shutil.copy(SOURCE / "robots" / "superball-paper.json", arm / "robot.json")
-            rolling = json.loads((SOURCE / "policies" / "superball-paper-t4-n5.json").read_text())
+            arm, rolling = make_arm(tmp)
             still = json.loads(json.dumps(rolling))
             for cable in still["cables"]:
                 cable["rest_lengths_m"] = [0.85] * len(cable["rest_lengths_m"])
@@ -68,10 +73,7 @@ class Plateau(unittest.TestCase):
 
     def test_a_damaged_curve_is_named(self):
         with tempfile.TemporaryDirectory() as tmp:
-            arm = pathlib.Path(tmp) / "arm"
-            arm.mkdir()
-            shutil.copy(SOURCE / "robots" / "superball-paper.json", arm / "robot.json")
-            rolling = json.loads((SOURCE / "policies" / "superball-paper-t4-n5.json").read_text())
+            arm, rolling = make_arm(tmp)
             seed(arm, "s1", rolling, [(5, 1), ("lost", 2)])
             done = subprocess.run(["/usr/bin/python3", str(TOOLS / "plateau.py"), str(arm), "--out", tmp + "/out",
                                    "--tensegrity", str(TENSEGRITY)], capture_output=True, text=True)
