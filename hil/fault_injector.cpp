@@ -102,8 +102,10 @@ void FaultInjector::start_frame_fault(const ScenarioEvent& ev, std::int64_t step
   } else {
     target.set_drop(ev.endcap, ev.params.probability);
   }
+  // A duration past any run (1e15 steps) is "to the end": llround of a bigger value is undefined.
+  const double steps = ev.params.duration_s / dt_s_;
   const std::int64_t until =
-      ev.params.duration_s > 0.0 ? step + static_cast<std::int64_t>(std::llround(ev.params.duration_s / dt_s_)) : -1;
+      ev.params.duration_s > 0.0 && steps < 1e15 ? step + static_cast<std::int64_t>(std::llround(steps)) : -1;
   frame_faults_.push_back({ev.endcap, corrupt, until});
 }
 

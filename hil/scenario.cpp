@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -43,6 +45,38 @@ FaultKind fault_from_name(const std::string& name, const std::string& where) {
   throw HilError(where + ": unknown fault '" + name + "' (known: " + known + ")");
 }
 
+// An integer of JSON in lo..hi, read without narrowing: get<int>() of 4294967295
+// is -1, which would turn a typo into "every motor".
+bool integer_in(const nlohmann::json& value, std::int64_t lo, std::int64_t hi) {
+  if (value.is_number_unsigned()) return value.get<std::uint64_t>() <= static_cast<std::uint64_t>(hi);
+  return value.is_number_integer() && value.get<std::int64_t>() >= lo && value.get<std::int64_t>() <= hi;
+}
+
+// The parameters each fault reads (FaultInjector): one it would ignore is refused, as a
+// typo in a name is, so a scenario never looks like it asks for something it does not.
+std::vector<std::string> params_of(FaultKind kind) {
+  switch (kind) {
+    case FaultKind::drive_fault: return {"motor", "code", "release"};
+    case FaultKind::drive_silent:
+    case FaultKind::release_spool:
+    case FaultKind::seize_spool:
+    case FaultKind::reboot_drive: return {"motor"};
+    case FaultKind::load_cell_drift: return {"n_per_s"};
+    case FaultKind::drop_frames: return {"probability", "duration_s"};
+    case FaultKind::corrupt_frames: return {"probability", "duration_s", "kind"};
+    default: return {};
+  }
+}
+
+void check_param_applies(FaultKind kind, const std::string& key, const std::string& at) {
+  const auto known = params_of(kind);
+  if (std::find(known.begin(), known.end(), key) != known.end()) return;
+  std::string list;
+  for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+  throw HilError(at + ": not a parameter of " + to_string(kind) +
+                 (list.empty() ? std::string(" (it takes none)") : " (its parameters: " + list + ")"));
+}
+
 void check_endcap(int endcap, int endcap_count, const std::string& where) {
   if (endcap < 0 || endcap >= endcap_count) {
     throw HilError(where + ": endcap " + std::to_string(endcap) + " out of range 0.." +
@@ -50,18 +84,17 @@ void check_endcap(int endcap, int endcap_count, const std::string& where) {
   }
 }
 
-FaultParams parse_params(const nlohmann::json& p, const std::string& where) {
+FaultParams parse_params(const nlohmann::json& p, FaultKind kind, const std::string& where) {
   FaultParams out;
   if (p.is_null()) return out;
   if (!p.is_object()) throw HilError(where + ".params: must be an object");
   for (const auto& [key, value] : p.items()) {
     const std::string at = where + ".params." + key;
     if (key == "motor") {
-      if (!value.is_number_integer() || value.get<int>() < -1 || value.get<int>() > 3)
-        throw HilError(at + ": an integer -1..3");
+      if (!integer_in(value, -1, 3)) throw HilError(at + ": an integer -1..3");
       out.motor = value.get<int>();
     } else if (key == "code") {
-      if (!value.is_number_unsigned() || value.get<unsigned>() > 0xFFFF) throw HilError(at + ": an integer 0..65535");
+      if (!integer_in(value, 0, 0xFFFF)) throw HilError(at + ": an integer 0..65535");
       out.code = static_cast<std::uint16_t>(value.get<unsigned>());
     } else if (key == "release") {
       if (!value.is_boolean()) throw HilError(at + ": true or false");
@@ -87,6 +120,7 @@ FaultParams parse_params(const nlohmann::json& p, const std::string& where) {
     } else {
       throw HilError(at + ": unknown parameter");
     }
+    check_param_applies(kind, key, at);
   }
   return out;
 }
@@ -168,15 +202,19 @@ Scenario parse_scenario(const std::string& text, int endcap_count, const std::st
     ev.fault = fault_from_name(e["fault"].get<std::string>(), where + ".fault");
     const bool needs_endcap = !is_dds_link_fault(ev.fault);
     if (e.contains("endcap")) {
-      if (!e["endcap"].is_number_integer()) throw HilError(where + ".endcap: an integer");
-      ev.endcap = e["endcap"].get<int>();
-      check_endcap(ev.endcap, endcap_count, where + ".endcap");
+      const auto& endcap = e["endcap"];
+      if (!endcap.is_number_integer()) throw HilError(where + ".endcap: an integer");
+      if (!integer_in(endcap, 0, endcap_count - 1)) {
+        throw HilError(where + ".endcap: endcap " + endcap.dump() + " out of range 0.." +
+                       std::to_string(endcap_count - 1));
+      }
+      ev.endcap = endcap.get<int>();
     } else if (needs_endcap) {
       throw HilError(where + ".endcap: required for " + to_string(ev.fault));
     } else {
       ev.endcap = -1;  // the link of every end cap: the host's own link is cut
     }
-    ev.params = parse_params(e.contains("params") ? e["params"] : nlohmann::json(), where);
+    ev.params = parse_params(e.contains("params") ? e["params"] : nlohmann::json(), ev.fault, where);
     scenario.events.push_back(ev);
   }
   sort_events(scenario);
@@ -224,12 +262,15 @@ ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
     std::size_t used = 0;
     const std::string when = text.substr(at + 1);
     ev.time_s = std::stod(when, &used);
-    if (used != when.size() || !(ev.time_s >= 0.0)) throw std::invalid_argument(when);
+    if (used != when.size() || !(ev.time_s >= 0.0) || !std::isfinite(ev.time_s)) throw std::invalid_argument(when);
     if (who == "all" && all_allowed) {
       ev.endcap = -1;
     } else {
-      ev.endcap = std::stoi(who, &used);
-      if (used != who.size()) throw std::invalid_argument(who);
+      // Digits only: stoi would also take " 3", "+3" and "3000000000" (out_of_range).
+      if (who.empty() || who.size() > 4 ||
+          !std::all_of(who.begin(), who.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        throw std::invalid_argument(who);
+      ev.endcap = std::stoi(who);
     }
   } catch (const std::exception&) {
     throw HilError("--fault '" + text + "': ENDCAP must be a number" + std::string(all_allowed ? " or 'all'" : "") +

@@ -99,6 +99,22 @@ TEST(HilFaultInjector, EventsBecomeActionsInTheStepTheyAreDue) {
   EXPECT_NE(log[5].find("not done for end cap 1: not running"), std::string::npos) << log[5];
 }
 
+// The parser takes any duration >= 0 JSON can write; one past any run is "to the end",
+// not a step count from an out-of-range llround.
+TEST(HilFaultInjector, ADurationPastAnyRunLastsToTheEnd) {
+  Scenario s;
+  FaultParams drop;
+  drop.probability = 1.0;
+  drop.duration_s = 1e300;
+  s.events = {event(0.001, 1, FaultKind::drop_frames, drop)};
+  FaultInjector injector(s, kDtS);
+  RecordingTarget target;
+  std::vector<std::string> log;
+  const auto by_step = run(injector, target, 200, log);
+  ASSERT_EQ(by_step.size(), 1u) << "started, never ended";
+  EXPECT_EQ(by_step[0].second, (std::vector<std::string>{"drop 1 1.000000"}));
+}
+
 TEST(HilFaultInjector, AMuteReachesTheNamedEndcapOrEveryOne) {
   Scenario s;
   s.events = {event(0.002, 2, FaultKind::mute_dds), event(0.004, -1, FaultKind::mute_dds)};

@@ -43,6 +43,56 @@ TEST(HilScenario, ErrorsNameTheField) {
             "s.json: events[0].params.probabilty: unknown parameter");
 }
 
+// Integers are read without narrowing: 4294967295 is not motor -1 (every motor), 65536
+// is not EMCY code 0, 4294967296 is not end cap 0.
+TEST(HilScenario, BigIntegersAreRefusedNotWrapped) {
+  const auto refused = [](const std::string& event) {
+    try {
+      parse_scenario("[" + event + "]", 12, "s.json");
+    } catch (const HilError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"motor": 4294967295}})"),
+            "s.json: events[0].params.motor: an integer -1..3");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"motor": -9223372036854775808}})"),
+            "s.json: events[0].params.motor: an integer -1..3");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"code": 65536}})"),
+            "s.json: events[0].params.code: an integer 0..65535");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 4294967296, "fault": "kill_endcap"})"),
+            "s.json: events[0].endcap: endcap 4294967296 out of range 0..11");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 18446744073709551615, "fault": "kill_endcap"})"),
+            "s.json: events[0].endcap: endcap 18446744073709551615 out of range 0..11");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1.5, "fault": "kill_endcap"})"), "s.json: events[0].endcap: an integer");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"motor": -1, "code": 65535}})"),
+            "accepted");
+}
+
+// A parameter the fault does not read is refused like a misspelt one: a scenario must
+// not look like it asks for something the run will not do.
+TEST(HilScenario, AParameterTheFaultIgnoresIsRefused) {
+  const auto refused = [](const std::string& event) {
+    try {
+      parse_scenario("[" + event + "]", 12, "s.json");
+    } catch (const HilError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "kill_endcap", "params": {"motor": 1}})"),
+            "s.json: events[0].params.motor: not a parameter of kill_endcap (it takes none)");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "drop_frames", "params": {"kind": "frame"}})"),
+            "s.json: events[0].params.kind: not a parameter of drop_frames (its parameters: probability, duration_s)");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "load_cell_stuck", "params": {"n_per_s": 3}})"),
+            "s.json: events[0].params.n_per_s: not a parameter of load_cell_stuck (it takes none)");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "load_cell_drift", "params": {"n_per_s": 3}})"), "accepted");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "seize_spool", "params": {"motor": 1}})"), "accepted");
+  EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "corrupt_frames", "params": {"kind": "datagram",
+            "probability": 1, "duration_s": 2}})"),
+            "accepted");
+}
+
 TEST(HilScenario, FaultOption) {
   const ScenarioEvent e = parse_fault_option("3:drive_silent@2.5", 12);
   EXPECT_EQ(e.endcap, 3);
@@ -56,6 +106,11 @@ TEST(HilScenario, FaultOption) {
   EXPECT_EQ(parse_scenario(R"([{"time_s": 1, "fault": "mute_dds"}])", 12).events.at(0).endcap, -1);
   EXPECT_THROW(parse_fault_option("all:kill_endcap@5", 12), HilError);  // "all" only for the link
   EXPECT_THROW(parse_fault_option("3:kill_endcap@5x", 12), HilError);
+  EXPECT_THROW(parse_fault_option("3:kill_endcap@inf", 12), HilError);
+  EXPECT_THROW(parse_fault_option("3:kill_endcap@nan", 12), HilError);
+  EXPECT_THROW(parse_fault_option(" 3:kill_endcap@1", 12), HilError);
+  EXPECT_THROW(parse_fault_option("+3:kill_endcap@1", 12), HilError);
+  EXPECT_THROW(parse_fault_option("3000000000:kill_endcap@1", 12), HilError);
 }
 
 TEST(HilScenario, SupervisionFaults) {

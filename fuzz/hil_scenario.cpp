@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: Apache-2.0
+// libFuzzer target: a HIL fault scenario (hil/scenario.hpp), the same bytes read both
+// as a scenario file (`tensegrity hil --scenario FILE`) and as one `--fault` option.
+// Oracle: only HilError escapes, and every event let through is one the fault
+// injector can act on as written.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+
+#include "hil/hil_error.hpp"
+#include "hil/scenario.hpp"
+
+namespace hil = tensegrity::hil;
+
+namespace {
+
+constexpr int kEndcaps = 12;
+
+void require(bool ok) {
+  if (!ok) std::abort();  // an event the parser should have refused
+}
+
+bool takes_no_params(hil::FaultKind kind) {
+  switch (kind) {
+    case hil::FaultKind::drive_fault:
+    case hil::FaultKind::drive_silent:
+    case hil::FaultKind::release_spool:
+    case hil::FaultKind::seize_spool:
+    case hil::FaultKind::reboot_drive:
+    case hil::FaultKind::load_cell_drift:
+    case hil::FaultKind::drop_frames:
+    case hil::FaultKind::corrupt_frames: return false;
+    default: return true;
+  }
+}
+
+void check(const hil::ScenarioEvent& ev) {
+  require(std::isfinite(ev.time_s) && ev.time_s >= 0.0);
+  require(ev.endcap == -1 ? hil::is_dds_link_fault(ev.fault) : ev.endcap >= 0 && ev.endcap < kEndcaps);
+  require(ev.params.motor >= -1 && ev.params.motor <= 3);
+  require(ev.params.probability >= 0.0 && ev.params.probability <= 1.0);
+  require(std::isfinite(ev.params.duration_s) && ev.params.duration_s >= 0.0);
+  require(std::isfinite(ev.params.n_per_s));
+  if (takes_no_params(ev.fault)) {
+    const hil::FaultParams none;
+    require(ev.params.motor == none.motor && ev.params.code == none.code && ev.params.release == none.release &&
+            ev.params.n_per_s == none.n_per_s && ev.params.probability == none.probability &&
+            ev.params.duration_s == none.duration_s && ev.params.corrupt_kind == none.corrupt_kind);
+  }
+  require(!ev.describe().empty());
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size > 16 * 1024) return -1;  // scenario files are a few hundred bytes
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const hil::Scenario s = hil::parse_scenario(text, kEndcaps, "fuzz");
+    for (const auto& ev : s.events) check(ev);
+    require(std::is_sorted(s.events.begin(), s.events.end(),
+                           [](const auto& a, const auto& b) { return a.time_s < b.time_s; }));
+  } catch (const hil::HilError&) {
+  }
+  try {
+    check(hil::parse_fault_option(text, kEndcaps));
+  } catch (const hil::HilError&) {
+  }
+  return 0;
+}
