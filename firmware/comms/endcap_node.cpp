@@ -114,6 +114,7 @@ void EndcapNode::stop() noexcept {
     wake();
     if (thread_.joinable()) thread_.join();
   }
+  pair_participants(false);
   // Entities deleted while dds_ still points at them (reset() would null it first).
   if (dds_) dds_->close();
   dds_.reset();

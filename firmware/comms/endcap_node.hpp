@@ -131,6 +131,7 @@ class EndcapNode final : public app::HostLink {
   void rejoin_unheard(const char* what, std::int64_t unheard_ns, const char* then);
   void rejoin();
   void retire() noexcept;
+  void pair_participants(bool paired) noexcept;
   // node_time_sync.cpp
   void send_time_sync_request();
   void report_if_unsynced();

@@ -3,7 +3,8 @@
 // sample, and what it delivers is acted on here at once. An emergency stop is a
 // counter the loop reads every cycle: it waits for nothing (not for the node
 // thread storing a table, not for room in a mailbox) and is acked as soon as it is
-// latched. Every addressed command is acked, whatever the answer.
+// latched. Every addressed command is acked, whatever the answer, on both participants
+// during a rejoin's overlap.
 #include <cstring>
 
 #include "firmware/comms/endcap_node.hpp"
@@ -109,6 +110,9 @@ void EndcapNode::send_command_ack(Dds& d, std::uint32_t seq, CommandReason reaso
   ack.reason(static_cast<std::uint8_t>(reason));
   ack.reason_text(describe(reason));
   d.command_ack->write(&ack);
+  // During a rejoin's overlap the host may hear only the other participant (a muted old
+  // one, or a new one not yet matched); the station takes the first ack of a sequence.
+  if (d.peer != nullptr) d.peer->command_ack->write(&ack);
 }
 
 }  // namespace tensegrity::fw::comms

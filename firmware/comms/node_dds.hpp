@@ -70,6 +70,10 @@ struct EndcapNode::Dds {
   std::atomic<bool> muted{false};  // fault injection: its transport sends nothing (EndcapNodeConfig)
   bool closed = false;             // guarded by callback_mutex
   bool retiring = false;           // replaced by a new participant, still listening; guarded by callback_mutex
+  // The other participant during a rejoin's overlap, which a command listener acks on
+  // too (node_commands.cpp); guarded by EndcapNode::receive_mutex_, and cleared under it
+  // before either participant closes.
+  Dds* peer = nullptr;
 
   ~Dds() { close(); }
   void close() noexcept {

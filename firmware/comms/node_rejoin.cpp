@@ -109,8 +109,9 @@ void EndcapNode::note_host_lost() {
 // before the old one goes: the stall may be one way only, so the old one can still
 // carry orders in (an emergency stop among them) until the link works both ways on
 // the new one, and it stays for good if a new one cannot be made. The two
-// participants' command listeners take turns (receive_mutex_), each acking on its
-// own participant; telemetry and heartbeats go out on the new one only.
+// participants' command listeners take turns (receive_mutex_), each acking on both
+// participants (which one the host hears is not known); telemetry and heartbeats go
+// out on the new one only.
 void EndcapNode::rejoin() {
   std::unique_ptr<Dds> fresh;
   try {
@@ -136,6 +137,7 @@ void EndcapNode::rejoin() {
     retiring_->retiring = true;
   }
   dds_ = std::move(fresh);
+  pair_participants(true);
   current_hears_host_ = false;
   rejoins_.fetch_add(1, std::memory_order_relaxed);
   // Counted from when it exists: a secured participant takes a second or more to make.
@@ -145,8 +147,15 @@ void EndcapNode::rejoin() {
   next_telemetry_ns_ = next_heartbeat_ns_ = next_sync_ns_ = made;
 }
 
+void EndcapNode::pair_participants(bool paired) noexcept {
+  std::lock_guard serial(receive_mutex_);  // no command listener is between its two acks
+  if (dds_ != nullptr) dds_->peer = paired ? retiring_.get() : nullptr;
+  if (retiring_ != nullptr) retiring_->peer = paired ? dds_.get() : nullptr;
+}
+
 void EndcapNode::retire() noexcept {
   if (retiring_ == nullptr) return;
+  pair_participants(false);
   retiring_->close();  // its listeners finish and are refused from then on
   retiring_.reset();
 }

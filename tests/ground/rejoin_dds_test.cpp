@@ -159,6 +159,32 @@ void estop_lands(Station& station, const EndcapRejoin& t, const char* when) {
   EXPECT_LT(estop.results[0].latency_s, 0.5);
 }
 
+// One command sent once while both participants listen (the old one muted): each
+// participant that takes it acks on both, so the station hears two acks, both by the
+// new participant; acking only on the participant that took it gives one. Sent once,
+// not retried; both acks leave within a millisecond of the old participant's check,
+// which comes at least 1 s before it may close (its new one must be named for 2 s).
+void a_command_in_the_overlap_is_acked_on_both(Station& station, const EndcapRejoin& t) {
+  ASSERT_EQ(t.log().find(kRetireLine), std::string::npos) << "the overlap is over already\n" << t.log();
+  msg::Command_ cmd;
+  cmd.format_version(msgs::kFormatVersion);
+  cmd.seq(0x7E57);
+  cmd.kind(static_cast<std::uint8_t>(CommandKind::emergency_stop));
+  cmd.endcap_mask(1U << kEndcap);
+  cmd.issued_host_time_ns(Station::now_ns());
+  station.take_command_acks();
+  station.write_command(cmd);
+  int acks = 0;
+  const std::int64_t until = Station::now_ns() + 500'000'000;
+  while (Station::now_ns() < until) {
+    station.wait_for_command_acks(until);
+    for (const auto& ack : station.take_command_acks()) {
+      if (ack.seq() == cmd.seq() && ack.endcap_id() == kEndcap && ack.accepted()) ++acks;
+    }
+  }
+  EXPECT_EQ(acks, 2) << "one per participant that took it, each on the heard one too\n" << t.log();
+}
+
 // A table uploaded while both participants listen reaches both (or, on a link
 // stalled one way, only the old one): it is acked and handed to the loop once.
 void upload_lands_once(Station& station, const EndcapRejoin& t) {
@@ -298,6 +324,7 @@ void muted_joins_again(EndcapRejoin& t, int domain, const fs::path& keystore) {
               report.results[0].latency_s, kRejoinS);
   EXPECT_GT(report.results[0].latency_s, 1.0);  // not by the muted participant
   EXPECT_EQ(t.rejoins(), 1) << t.log();
+  a_command_in_the_overlap_is_acked_on_both(station, t);
 
   EXPECT_TRUE(t.wait_for_line(kRetireLine, 15.0)) << t.log();
   estop_lands(station, t, "on the end cap that was muted");
