@@ -288,6 +288,8 @@ void DdsProvisioner::begin_run() {
   // Lockstep rejoins need no host: start on boot + the stepper's gate.
   if (config_.mode != StepperMode::realtime || supervisor_.joinable()) return;
   stopping_ = false;
+  run_begun_ns_ = ground::Station::now_ns();
+  unheard_since_ns_.assign(restarted_at_ns_.size(), 0);
   supervisor_ = std::thread([this] {
     normal_priority();
     supervise();
@@ -305,6 +307,8 @@ void DdsProvisioner::end_run() {
 void DdsProvisioner::supervise() {
   while (!stopping_) {
     std::this_thread::sleep_for(kSupervisePeriod);
+    const auto status = station_->snapshot();
+    watch_link(status, ground::Station::now_ns());
     std::vector<std::pair<int, std::int64_t>> pending;
     {
       std::lock_guard lock(mutex_);
@@ -313,7 +317,6 @@ void DdsProvisioner::supervise() {
       }
     }
     if (pending.empty()) continue;
-    const auto status = station_->snapshot();
     for (const auto& [e, since] : pending) {
       const ground::EndcapStatus& s = status[e];
       if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {

@@ -15,6 +15,7 @@
 //    time; an end cap started "in the past" plays its table that far along.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -97,6 +98,10 @@ class DdsProvisioner final : public Provisioner {
   std::int64_t place_start(StartHandshake& handshake, std::string& how);
   void send_start(std::uint16_t mask, std::int64_t start_ns);
   void supervise();
+  // The host's side of the link during a real-time run (dds_provisioner_link.cpp): an
+  // end cap unheard for kUnheardAfterNs is logged, and again when it is heard, with how
+  // long, so a lost or muted end cap is seen in the run's log. Supervisor thread only.
+  void watch_link(const std::array<ground::EndcapStatus, ground::kEndcapCount>& status, std::int64_t now_ns);
   // End caps of `mask` that report a latched fault get one clear-fault (the
   // operator's `tensegrity clear-fault` before a start), logged; returns false if
   // one is still faulted by `deadline_ns`.
@@ -121,6 +126,8 @@ class DdsProvisioner final : public Provisioner {
   std::vector<std::int64_t> restarted_at_ns_;  // per end cap: host time of a restart not yet started (0: none)
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
+  std::int64_t run_begun_ns_ = 0;               // host clock at begin_run (the supervisor's start)
+  std::vector<std::int64_t> unheard_since_ns_;  // per end cap: its last heartbeat while unheard (0: heard)
 };
 
 }  // namespace tensegrity::hil

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // DdsProvisioner, step 1: every end cap on the link with a synchronized clock, and
-// how long that took (the link's timing, for `bench hil`).
+// how long that took (the link's timing, for `bench hil`); and during a real-time
+// run, the host's view of that link.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -83,6 +84,30 @@ void DdsProvisioner::await_endcaps(std::uint16_t mask, std::int64_t deadline_ns)
   if (!missing.empty()) why += ", no heartbeat from end cap(s) " + list(missing);
   if (!unsynced.empty()) why += ", clock not synchronized on end cap(s) " + list(unsynced);
   throw LinkDownError(why + " (see their logs)");
+}
+
+// The end cap's heartbeat comes at 5 Hz; 2 s without one is what the end caps and the
+// operator console's station keeper call unheard (a host's window).
+void DdsProvisioner::watch_link(const std::array<ground::EndcapStatus, ground::kEndcapCount>& status,
+                                std::int64_t now_ns) {
+  constexpr std::int64_t kUnheardAfterNs = 2 * kNsPerS;
+  const auto run_s = [this](std::int64_t host_ns) { return static_cast<double>(host_ns - run_begun_ns_) * 1e-9; };
+  for (std::size_t e = 0; e < unheard_since_ns_.size() && e < status.size(); ++e) {
+    const ground::EndcapStatus& s = status[e];
+    const std::int64_t last = s.seen ? s.heartbeat_host_ns : run_begun_ns_;
+    char line[160];
+    if (unheard_since_ns_[e] == 0 && now_ns - std::max(last, run_begun_ns_) > kUnheardAfterNs) {
+      unheard_since_ns_[e] = std::max(last, run_begun_ns_);
+      std::snprintf(line, sizeof line, "dds: end cap %zu unheard by the host since %.1f s into the run", e,
+                    run_s(unheard_since_ns_[e]));
+      note(line);
+    } else if (unheard_since_ns_[e] != 0 && last > unheard_since_ns_[e]) {
+      std::snprintf(line, sizeof line, "dds: end cap %zu heard again at %.1f s into the run, after %.1f s unheard", e,
+                    run_s(last), static_cast<double>(last - unheard_since_ns_[e]) * 1e-9);
+      unheard_since_ns_[e] = 0;
+      note(line);
+    }
+  }
 }
 
 }  // namespace tensegrity::hil
