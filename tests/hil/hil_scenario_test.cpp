@@ -7,6 +7,16 @@
 namespace tensegrity::hil {
 namespace {
 
+// A scenario of one event: its error, or "accepted".
+std::string refused(const std::string& event) {
+  try {
+    parse_scenario("[" + event + "]", 12, "s.json");
+  } catch (const HilError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 TEST(HilScenario, ParsesSortsAndDefaults) {
   const Scenario s = parse_scenario(R"({"format": "tensegrity-hil-scenario/1", "events": [
       {"time_s": 3.0, "endcap": 4, "fault": "kill_endcap"},
@@ -46,14 +56,6 @@ TEST(HilScenario, ErrorsNameTheField) {
 // Integers are read without narrowing: 4294967295 is not motor -1 (every motor), 65536
 // is not EMCY code 0, 4294967296 is not end cap 0.
 TEST(HilScenario, BigIntegersAreRefusedNotWrapped) {
-  const auto refused = [](const std::string& event) {
-    try {
-      parse_scenario("[" + event + "]", 12, "s.json");
-    } catch (const HilError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"motor": 4294967295}})"),
             "s.json: events[0].params.motor: an integer -1..3");
   EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 1, "fault": "drive_fault", "params": {"motor": -9223372036854775808}})"),
@@ -72,14 +74,6 @@ TEST(HilScenario, BigIntegersAreRefusedNotWrapped) {
 // A parameter the fault does not read is refused like a misspelt one: a scenario must
 // not look like it asks for something the run will not do.
 TEST(HilScenario, AParameterTheFaultIgnoresIsRefused) {
-  const auto refused = [](const std::string& event) {
-    try {
-      parse_scenario("[" + event + "]", 12, "s.json");
-    } catch (const HilError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "kill_endcap", "params": {"motor": 1}})"),
             "s.json: events[0].params.motor: not a parameter of kill_endcap (it takes none)");
   EXPECT_EQ(refused(R"({"time_s": 1, "endcap": 2, "fault": "drop_frames", "params": {"kind": "frame"}})"),
