@@ -103,6 +103,7 @@ hil::HilOptions make_options(const HilArgs& a) {
       o.scenario.events.push_back(hil::disabled_cable_event(robot, cable, failure));
     }
     hil::sort_events(o.scenario);
+    hil::check_scenario(o.scenario, robot);
   } catch (const hil::HilError& e) {
     throw CommandError(2, e.what());
   }

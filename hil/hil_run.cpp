@@ -150,6 +150,7 @@ void load_inputs(const HilOptions& options, RunParts& parts) {
                                                                  ? sim::default_robot_path()
                                                                  : sim::robot_path_for_policy(options.policy)));
   if (options.policy.empty()) throw HilError("no policy file (--policy)");
+  check_scenario(options.scenario, *parts.robot);
   // Fail early, with the field.
   parts.policy = std::make_unique<sim::Policy>(sim::load_policy(options.policy, *parts.robot));
   // Before the launch and the priority raise: a DDS participant's threads take

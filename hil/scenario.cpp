@@ -221,6 +221,24 @@ Scenario parse_scenario(const std::string& text, int endcap_count, const std::st
   return scenario;
 }
 
+void check_scenario(const Scenario& scenario, const sim::Robot& robot) {
+  for (std::size_t i = 0; i < scenario.events.size(); ++i) {
+    const ScenarioEvent& ev = scenario.events[i];
+    const std::string where = "scenario event " + std::to_string(i) + " (" + ev.describe() + ")";
+    if (ev.endcap >= robot.endcap_count() || (ev.endcap < 0 && !is_dds_link_fault(ev.fault))) {
+      throw HilError(where + ": the robot has end caps 0.." + std::to_string(robot.endcap_count() - 1));
+    }
+    const auto params = params_of(ev.fault);
+    if (ev.endcap < 0 || ev.params.motor < 0 || std::find(params.begin(), params.end(), "motor") == params.end())
+      continue;
+    const auto motors = robot.cables_of(ev.endcap).size();
+    if (static_cast<std::size_t>(ev.params.motor) >= motors) {
+      throw HilError(where + ": end cap " + std::to_string(ev.endcap) + " has motors 0.." + std::to_string(motors - 1) +
+                     " (-1: all)");
+    }
+  }
+}
+
 Scenario load_scenario(const std::filesystem::path& path, int endcap_count) {
   std::ifstream in(path);
   if (!in) throw HilError(path.string() + ": cannot read");

@@ -75,6 +75,10 @@ Scenario load_scenario(const std::filesystem::path& path, int endcap_count);
 // for the DDS link faults.
 ScenarioEvent parse_fault_option(const std::string& text, int endcap_count);
 void sort_events(Scenario& scenario);
+// What the parser cannot know: every end cap named is one of the robot's, and every
+// motor named one its end cap has (one motor on a robot with 2 per end cap). Throws
+// HilError naming the event, before anything starts rather than when it is due.
+void check_scenario(const Scenario& scenario, const sim::Robot& robot);
 // How a disabled cable fails (tensegrity hil --cable-failure).
 enum class CableFailure : std::uint8_t {
   drive,  // its drive faults (EMCY) and releases it: slack; its end cap goes to its safe state (other cable held)

@@ -127,6 +127,39 @@ TEST(HilScenario, SupervisionFaults) {
   EXPECT_THROW(parse_scenario(R"([{"time_s": 1, "fault": "hang_loop"}])", 12), HilError) << "needs an end cap";
 }
 
+// The parser takes motors -1..3 and end caps below the count it is given; the robot
+// decides the rest before the run starts, not 30 s into it.
+TEST(HilScenario, EventsAreCheckedAgainstTheRobotBeforeTheRun) {
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));  // 2 motors per end cap
+  const auto check = [&robot](const std::string& option) {
+    Scenario s;
+    s.events = {parse_fault_option("1:kill_endcap@0.5", 16), parse_fault_option(option, 16)};
+    try {
+      check_scenario(s, robot);
+    } catch (const HilError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(check("3:seize_spool@1"), "accepted");
+  EXPECT_EQ(check("all:cut_dds@1"), "accepted");
+  EXPECT_EQ(check("12:kill_endcap@1"),
+            "scenario event 1 (t=1 s end cap 12: kill_endcap): the robot has end caps 0..11");
+  Scenario s = parse_scenario(R"([{"time_s": 2, "endcap": 4, "fault": "drive_fault", "params": {"motor": 2}},
+                                  {"time_s": 3, "endcap": 4, "fault": "drive_silent", "params": {"motor": -1}}])",
+                              12);
+  try {
+    check_scenario(s, robot);
+    ADD_FAILURE() << "motor 2 of a 2-motor end cap accepted";
+  } catch (const HilError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "scenario event 0 (t=2 s end cap 4: drive_fault (motor 2, EMCY 0x2310, holding)): end cap 4 has motors "
+              "0..1 (-1: all)");
+  }
+  s.events.erase(s.events.begin());
+  EXPECT_NO_THROW(check_scenario(s, robot)) << "-1: every motor";
+}
+
 TEST(HilScenario, DisabledCableFaultsItsOwnersDriveAndReleasesIt) {
   const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   // Cable 3 (nodes 0-10) is owned by end cap 10, whose cables are 3 and 16.
