@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a HIL fault scenario (hil/scenario.hpp), the same bytes read both
 // as a scenario file (`tensegrity hil --scenario FILE`) and as one `--fault` option.
-// Oracle: only HilError escapes, and every event let through is one the fault
-// injector can act on as written.
+// Oracle: only HilError escapes, and every event let through, and then passed by the
+// check against DESIGN.md's robot, is one the fault injector can act on as written.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -12,6 +12,7 @@
 
 #include "hil/hil_error.hpp"
 #include "hil/scenario.hpp"
+#include "sim/robot.hpp"
 
 namespace hil = tensegrity::hil;
 
@@ -21,6 +22,24 @@ constexpr int kEndcaps = 12;
 
 void require(bool ok) {
   if (!ok) std::abort();  // an event the parser should have refused
+}
+
+const tensegrity::sim::Robot& robot() {
+  static const auto r = tensegrity::sim::load_robot(tensegrity::sim::robot_path_named("superball"));
+  return r;
+}
+
+// Past check_scenario, a motor named is one the end cap has.
+void check_motors(const hil::Scenario& s) {
+  try {
+    hil::check_scenario(s, robot());
+  } catch (const hil::HilError&) {
+    return;
+  }
+  for (const auto& ev : s.events) {
+    if (ev.endcap >= 0 && ev.params.motor >= 0)
+      require(static_cast<std::size_t>(ev.params.motor) < robot().cables_of(ev.endcap).size());
+  }
 }
 
 bool takes_no_params(hil::FaultKind kind) {
@@ -63,10 +82,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const auto& ev : s.events) check(ev);
     require(std::is_sorted(s.events.begin(), s.events.end(),
                            [](const auto& a, const auto& b) { return a.time_s < b.time_s; }));
+    check_motors(s);
   } catch (const hil::HilError&) {
   }
   try {
-    check(hil::parse_fault_option(text, kEndcaps));
+    const hil::ScenarioEvent ev = hil::parse_fault_option(text, kEndcaps);
+    check(ev);
+    check_motors(hil::Scenario{{ev}});
   } catch (const hil::HilError&) {
   }
   return 0;
