@@ -233,8 +233,9 @@ void check_scenario(const Scenario& scenario, const sim::Robot& robot) {
       continue;
     const auto motors = robot.cables_of(ev.endcap).size();
     if (static_cast<std::size_t>(ev.params.motor) >= motors) {
-      throw HilError(where + ": end cap " + std::to_string(ev.endcap) + " has motors 0.." + std::to_string(motors - 1) +
-                     " (-1: all)");
+      throw HilError(
+          where + ": end cap " + std::to_string(ev.endcap) + " has " +
+          (motors == 0 ? std::string("no motors") : "motors 0.." + std::to_string(motors - 1) + " (-1: all)"));
     }
   }
 }
