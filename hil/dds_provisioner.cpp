@@ -290,6 +290,10 @@ void DdsProvisioner::begin_run() {
   stopping_ = false;
   run_begun_ns_ = ground::Station::now_ns();
   unheard_since_ns_.assign(restarted_at_ns_.size(), 0);
+  {
+    std::lock_guard lock(mutex_);
+    hearing_.assign(restarted_at_ns_.size(), HostHearing{});
+  }
   supervisor_ = std::thread([this] {
     normal_priority();
     supervise();
@@ -298,7 +302,9 @@ void DdsProvisioner::begin_run() {
 
 void DdsProvisioner::end_run() {
   stopping_ = true;
-  if (supervisor_.joinable()) supervisor_.join();
+  if (!supervisor_.joinable()) return;
+  supervisor_.join();
+  run_ended_ns_ = ground::Station::now_ns();
 }
 
 // Real time: a restarted end cap is idle with its stored table. Once it is back on

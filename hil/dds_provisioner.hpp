@@ -86,6 +86,7 @@ class DdsProvisioner final : public Provisioner {
   bool dds_link() const override { return true; }
   void on_restart(int endcap) override;
   std::vector<std::string> log() const override;
+  std::vector<HostHearing> host_hearing() const override;
 
   int domain() const { return lease_.domain(); }
 
@@ -127,7 +128,9 @@ class DdsProvisioner final : public Provisioner {
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
   std::int64_t run_begun_ns_ = 0;               // host clock at begin_run (the supervisor's start)
+  std::int64_t run_ended_ns_ = 0;               // ... at end_run
   std::vector<std::int64_t> unheard_since_ns_;  // per end cap: its last heartbeat while unheard (0: heard)
+  std::vector<HostHearing> hearing_;            // per end cap, closed spells; under mutex_
 };
 
 }  // namespace tensegrity::hil

@@ -102,12 +102,32 @@ void DdsProvisioner::watch_link(const std::array<ground::EndcapStatus, ground::k
                     run_s(unheard_since_ns_[e]));
       note(line);
     } else if (unheard_since_ns_[e] != 0 && last > unheard_since_ns_[e]) {
+      const double spell_s = static_cast<double>(last - unheard_since_ns_[e]) * 1e-9;
       std::snprintf(line, sizeof line, "dds: end cap %zu heard again at %.1f s into the run, after %.1f s unheard", e,
-                    run_s(last), static_cast<double>(last - unheard_since_ns_[e]) * 1e-9);
+                    run_s(last), spell_s);
       unheard_since_ns_[e] = 0;
       note(line);
+      std::lock_guard lock(mutex_);
+      HostHearing& h = hearing_.at(e);
+      ++h.unheard;
+      h.unheard_s += spell_s;
+      h.longest_unheard_s = std::max(h.longest_unheard_s, spell_s);
     }
   }
+}
+
+// After end_run: the supervisor is gone, and a spell still open lasts to the run's end.
+std::vector<HostHearing> DdsProvisioner::host_hearing() const {
+  std::lock_guard lock(mutex_);
+  std::vector<HostHearing> out = hearing_;
+  for (std::size_t e = 0; e < out.size() && e < unheard_since_ns_.size(); ++e) {
+    if (unheard_since_ns_[e] == 0 || run_ended_ns_ == 0) continue;
+    const double spell_s = static_cast<double>(run_ended_ns_ - unheard_since_ns_[e]) * 1e-9;
+    ++out[e].unheard;
+    out[e].unheard_s += spell_s;
+    out[e].longest_unheard_s = std::max(out[e].longest_unheard_s, spell_s);
+  }
+  return out;
 }
 
 }  // namespace tensegrity::hil

@@ -8,6 +8,16 @@
 
 namespace tensegrity::hil {
 
+namespace {
+std::string unheard_text(const HostHearing& h) {
+  if (h.unheard == 0) return "";
+  char text[96];
+  std::snprintf(text, sizeof text, " (host: unheard %llux, %.1f s)", static_cast<unsigned long long>(h.unheard),
+                h.unheard_s);
+  return text;
+}
+}  // namespace
+
 nlohmann::json to_json(const HilResult& r) {
   nlohmann::json endcaps = nlohmann::json::array();
   for (const auto& s : r.endcaps) {
@@ -21,6 +31,9 @@ nlohmann::json to_json(const HilResult& r) {
                        {"dds_link_cuts", s.link_cuts},
                        {"loop_stalls", s.loop_stalls},
                        {"dds_rejoins", s.dds_rejoins},
+                       {"host_unheard", s.host.unheard},
+                       {"host_unheard_s", s.host.unheard_s},
+                       {"host_longest_unheard_s", s.host.longest_unheard_s},
                        {"exit_status", s.exit_status},
                        {"cpu_s", s.cpu_s},
                        {"restarts", s.restarts},
@@ -117,7 +130,7 @@ std::string summary_text(const HilResult& r) {
                   static_cast<unsigned long long>(e.bus.injected_corrupt),
                   static_cast<unsigned long long>(e.devices.emcy_sent), e.cpu_s, drives.c_str(),
                   (std::string(e.restarts ? " (restarted " + std::to_string(e.restarts) + "x)" : "") +
-                   (e.dds_rejoins ? " (DDS rejoins " + std::to_string(e.dds_rejoins) + ")" : ""))
+                   (e.dds_rejoins ? " (DDS rejoins " + std::to_string(e.dds_rejoins) + ")" : "") + unheard_text(e.host))
                       .c_str());
     s << line;
   }

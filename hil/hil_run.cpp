@@ -288,7 +288,12 @@ void collect(const HilOptions& options, RunParts& parts, HilResult& result) {
   }
   if (parts.launcher) {
     const auto reports = parts.launcher->shutdown();
-    for (const auto& r : reports) result.endcaps.push_back(summarize(r, parts));
+    const auto hearing = parts.provisioner ? parts.provisioner->host_hearing() : std::vector<HostHearing>{};
+    for (const auto& r : reports) {
+      result.endcaps.push_back(summarize(r, parts));
+      if (static_cast<std::size_t>(r.endcap) < hearing.size())
+        result.endcaps.back().host = hearing[static_cast<std::size_t>(r.endcap)];
+    }
     phase_offsets(result.endcaps, reports, options.mode, result);
   }
   if (parts.hub) result.hub_syscalls = parts.hub->syscalls();

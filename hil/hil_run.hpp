@@ -98,6 +98,9 @@ struct EndcapSummary {
   std::uint64_t link_cuts = 0;
   std::uint64_t loop_stalls = 0;
   std::uint64_t dds_rejoins = 0;
+  // The host's side (real time, dds; provisioner.hpp's HostHearing): how often and how
+  // long it went 2 s or more without this end cap's heartbeat.
+  HostHearing host;
 };
 
 struct HilResult {

@@ -12,6 +12,7 @@
 // the end caps running while it works, so the stepper holds them (needs_hold()).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -28,6 +29,15 @@ struct LinkTiming {
   bool secured = false;      // DDS Security (a keystore's enclaves)
   double discovery_s = 0.0;  // every end cap's heartbeat with a synchronized clock
   double upload_s = 0.0;     // the policy upload, first send to the last acknowledgement
+};
+
+// How the host heard one end cap during the run (real time, dds): its heartbeat
+// missing for 2 s or more, how often, how long in all, the longest (one still open at
+// the run's end counts to the end).
+struct HostHearing {
+  std::uint64_t unheard = 0;
+  double unheard_s = 0.0;
+  double longest_unheard_s = 0.0;
 };
 
 class Provisioner {
@@ -60,6 +70,8 @@ class Provisioner {
   // What the provisioner did, one line each, for the run's log.
   virtual std::vector<std::string> log() const { return {}; }
   virtual LinkTiming link_timing() const { return {}; }
+  // Per end cap; empty when the provisioner does not watch a link.
+  virtual std::vector<HostHearing> host_hearing() const { return {}; }
 };
 
 class LocalProvisioner final : public Provisioner {
