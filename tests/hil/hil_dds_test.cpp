@@ -192,6 +192,30 @@ TEST(HilDds, AMutedEndcapJoinsAgainAndPlaysOn) {
       host.longest_unheard_s, static_cast<unsigned long long>(r.endcaps.at(5).host_losses), r.distance_m, o.duration_s);
 }
 
+// An end cap that dies is seen from the host's side too: killed 1 s into a 6 s
+// real-time run and not started again, it is unheard from then to the end (the spell
+// still open at the end counts to the end), and the run's log says since when.
+TEST(HilDds, AKilledEndcapIsUnheardByTheHostToTheEnd) {
+  TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
+  HilOptions o = options(6.0, Provision::dds);
+  o.mode = StepperMode::realtime;
+  ScenarioEvent kill;
+  kill.time_s = 1.0;
+  kill.endcap = 4;
+  kill.fault = FaultKind::kill_endcap;
+  o.scenario.events = {kill};
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  const HostHearing& host = r.endcaps.at(4).host;
+  EXPECT_EQ(host.unheard, 1U);
+  EXPECT_GT(host.unheard_s, 3.5);  // from its last heartbeat, about 1 s in, to the end at 6 s
+  EXPECT_LT(host.unheard_s, 8.0);
+  EXPECT_EQ(host.longest_unheard_s, host.unheard_s);
+  EXPECT_TRUE(logged(r, "end cap 4 unheard by the host since", "s into the run")) << ::testing::PrintToString(r.log);
+  EXPECT_FALSE(logged(r, "end cap 4 heard again", "")) << ::testing::PrintToString(r.log);
+  std::printf("killed end cap 4 at 1 s: unheard by the host for the last %.1f s\n", host.unheard_s);
+}
+
 // The counts travel in each end cap's --stats-json, and a killed program's last
 // snapshot is kept: end cap 4's link cut happened to the incarnation killed after
 // it, and the run's summary still has it.
