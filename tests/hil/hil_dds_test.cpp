@@ -28,12 +28,22 @@ double in_process_m(const std::filesystem::path& policy, double duration_s) {
   return sim::run_episode(robot(), reference, eo).distance_m;
 }
 
-ScenarioEvent link_event(double time_s, FaultKind fault) {
+ScenarioEvent endcap_event(double time_s, int endcap, FaultKind fault) {
   ScenarioEvent e;
   e.time_s = time_s;
-  e.endcap = -1;  // every end cap: the host's link
+  e.endcap = endcap;  // -1: every end cap (DDS link faults only)
   e.fault = fault;
   return e;
+}
+
+ScenarioEvent link_event(double time_s, FaultKind fault) { return endcap_event(time_s, -1, fault); }
+
+// A real-time run over DDS with one event.
+HilOptions realtime_with(double duration_s, const ScenarioEvent& event) {
+  HilOptions o = options(duration_s, Provision::dds);
+  o.mode = StepperMode::realtime;
+  o.scenario.events = {event};
+  return o;
 }
 
 bool logged(const HilResult& r, const std::string& a, const std::string& b) {
@@ -160,14 +170,8 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
 // and is heard again; the open-loop gait never knew: all twelve play to the end.
 TEST(HilDds, AMutedEndcapJoinsAgainAndPlaysOn) {
   TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
-  HilOptions o = options(36.0, Provision::dds);
-  o.mode = StepperMode::realtime;
+  HilOptions o = realtime_with(36.0, endcap_event(2.0, 5, FaultKind::mute_dds));
   o.policy = evolved_policy_file();
-  ScenarioEvent mute;
-  mute.time_s = 2.0;
-  mute.endcap = 5;
-  mute.fault = FaultKind::mute_dds;
-  o.scenario.events = {mute};
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
   for (const auto& e : r.endcaps) {
@@ -197,14 +201,7 @@ TEST(HilDds, AMutedEndcapJoinsAgainAndPlaysOn) {
 // still open at the end counts to the end), and the run's log says since when.
 TEST(HilDds, AKilledEndcapIsUnheardByTheHostToTheEnd) {
   TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
-  HilOptions o = options(6.0, Provision::dds);
-  o.mode = StepperMode::realtime;
-  ScenarioEvent kill;
-  kill.time_s = 1.0;
-  kill.endcap = 4;
-  kill.fault = FaultKind::kill_endcap;
-  o.scenario.events = {kill};
-  const HilResult r = run_hil(o);
+  const HilResult r = run_hil(realtime_with(6.0, endcap_event(1.0, 4, FaultKind::kill_endcap)));
   ASSERT_TRUE(r.ok) << r.error;
   const HostHearing& host = r.endcaps.at(4).host;
   EXPECT_EQ(host.unheard, 1U);
