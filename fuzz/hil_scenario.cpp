@@ -42,6 +42,8 @@ void check_motors(const hil::Scenario& s) {
   }
 }
 
+// Stated here from what FaultInjector reads, not taken from the parser's own table:
+// an oracle that shared it would pass whatever the table says.
 bool takes_no_params(hil::FaultKind kind) {
   switch (kind) {
     case hil::FaultKind::drive_fault:

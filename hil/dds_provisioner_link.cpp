@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "ground/station_keeper.hpp"
 #include "hil/dds_provisioner.hpp"
 #include "hil/hil_error.hpp"
 
@@ -86,11 +87,12 @@ void DdsProvisioner::await_endcaps(std::uint16_t mask, std::int64_t deadline_ns)
   throw LinkDownError(why + " (see their logs)");
 }
 
-// The end cap's heartbeat comes at 5 Hz; 2 s without one is what the end caps and the
-// operator console's station keeper call unheard (a host's window).
+// The end cap's heartbeat comes at 5 Hz; the operator console's station keeper calls an
+// end cap unheard after its fresh_s (2 s, the end caps' own host window), and so does this.
 void DdsProvisioner::watch_link(const std::array<ground::EndcapStatus, ground::kEndcapCount>& status,
                                 std::int64_t now_ns) {
-  constexpr std::int64_t kUnheardAfterNs = 2 * kNsPerS;
+  static const auto kUnheardAfterNs =
+      static_cast<std::int64_t>(ground::StationKeeper::Options{}.fresh_s * static_cast<double>(kNsPerS));
   const auto run_s = [this](std::int64_t host_ns) { return static_cast<double>(host_ns - run_begun_ns_) * 1e-9; };
   for (std::size_t e = 0; e < unheard_since_ns_.size() && e < status.size(); ++e) {
     const ground::EndcapStatus& s = status[e];
