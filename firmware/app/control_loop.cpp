@@ -18,6 +18,9 @@ using core::FaultCause;
 namespace {
 constexpr double kNsToS = 1e-9;
 
+// Counters wrap: `a` is newer than `b` when it is less than half the range ahead.
+bool ahead(std::uint32_t a, std::uint32_t b) { return static_cast<std::int32_t>(a - b) > 0; }
+
 bool is_sync(const CanFrame& f) { return !f.extended && !f.rtr && f.id == canopen::kSyncCobId && f.dlc <= 1; }
 
 bool quick_stops(FaultCause c) {
@@ -132,14 +135,14 @@ void ControlLoop::handle_bring_up(std::int64_t time_ns) {
   }
 }
 
-// Counters the host link raises (emergency_stops, host_loss_stops): a change since
-// the last look is a stop to apply now.
+// Counters the host link raises (emergency_stops, host_loss_stops): a count ahead of
+// the last one applied is a stop to apply now; an older one was applied already.
 void ControlLoop::apply_host_stops(std::uint32_t estops, std::uint32_t host_loss_stops, std::int64_t time_ns) {
-  if (estops != estops_seen_) {
+  if (ahead(estops, estops_seen_)) {
     estops_seen_ = estops;
     latch(FaultCause::emergency_stop, time_ns);
   }
-  if (host_loss_stops != host_loss_stops_seen_) {
+  if (ahead(host_loss_stops, host_loss_stops_seen_)) {
     host_loss_stops_seen_ = host_loss_stops;
     HostCommand stop;
     stop.kind = CommandKind::stop;
@@ -186,15 +189,21 @@ void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns
 }
 
 void ControlLoop::handle_host(std::int64_t time_ns) {
+  // The counters first: the link queues a command before it counts a later estop,
+  // so each command sent before an estop counted here is queued now and applied
+  // first. Read after the queue ran dry, the count could take in an estop whose
+  // earlier clear-fault, queued in between, would be applied after it and undo it.
+  const std::uint32_t estops = host_.emergency_stops();
+  const std::uint32_t host_loss_stops = host_.host_loss_stops();
   HostCommand command;
   while (host_.try_take_command(command)) {
     // An estop sent before this command lands first (HostCommand::estops_before).
-    if (static_cast<std::int32_t>(command.estops_before - estops_seen_) > 0) {
+    if (ahead(command.estops_before, estops_seen_)) {
       apply_host_stops(command.estops_before, host_loss_stops_seen_, time_ns);
     }
     apply_command(command, time_ns);
   }
-  apply_host_stops(host_.emergency_stops(), host_.host_loss_stops(), time_ns);
+  apply_host_stops(estops, host_loss_stops, time_ns);
   if (pending_start_ && time_ns >= pending_start_ns_) {
     pending_start_ = false;
     try_start(pending_start_ns_, time_ns);
@@ -244,6 +253,9 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
   const bool resetting = cause == FaultCause::drive_fault || cause == FaultCause::drive_disabled;
   if (resetting && time_ns < grace_until_ns_) cause = FaultCause::none;
   latch(cause, time_ns);
+  // A stop latched before or during a bring-up outlasts it: the bring-up's own
+  // request to enable the drives must not undo an operator's stop.
+  if (quick_stops(controller_.fault())) master_.request_power(PowerRequest::quick_stop);
 
   // The newest valid reading per motor; a channel that stays invalid trips
   // sensor_timeout above, so holding the last value bridges single bad samples only.

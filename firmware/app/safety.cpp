@@ -58,10 +58,15 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   for (std::size_t i = 0; i < master.drive_count(); ++i) {
     if (!master.drive_heartbeat(i).alive) return FaultCause::drive_lost;
   }
+  // Every drive is checked for the faults that quick-stop before any for a milder
+  // one: a stale position latched on one drive must not hide another leaving
+  // operation enabled, which would otherwise be stepped back up unseen.
   const bool enable_wanted = master.power_request() == canopen::PowerRequest::operation_enabled;
   for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    if (enable_wanted && master.drive(i).state != Cia402State::operation_enabled) return FaultCause::drive_disabled;
+  }
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
     const canopen::DriveStatus& d = master.drive(i);
-    if (enable_wanted && d.state != Cia402State::operation_enabled) return FaultCause::drive_disabled;
     const std::int64_t since = d.position_updated_ns > armed_ns_ ? d.position_updated_ns : armed_ns_;
     if (now_ns - since > config_.drive_position_timeout_ns) return FaultCause::stale_position;
   }

@@ -188,7 +188,9 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
   fail_step_after_timeout(now_ns);
 }
 
-// True when the enable step ended: every drive operation enabled, or one in fault.
+// True when the enable step ended: every drive operation enabled, one in fault, or
+// the end cap asked for a stop meanwhile (its stop outlasts the bring-up: the nodes
+// are up and the drives stay stopped until it asks for them again).
 bool CanopenMaster::step_enable(std::int64_t now_ns) {
   BringUp& b = bring_up_;
   bool all_enabled = true;
@@ -202,8 +204,9 @@ bool CanopenMaster::step_enable(std::int64_t now_ns) {
     }
     all_enabled = all_enabled && state == Cia402State::operation_enabled;
   }
-  if (all_enabled) enter_step(BringUpStep::done, now_ns);
-  return all_enabled;
+  const bool done = all_enabled || power_request() != PowerRequest::operation_enabled;
+  if (done) enter_step(BringUpStep::done, now_ns);
+  return done;
 }
 
 void CanopenMaster::fail_step_after_timeout(std::int64_t now_ns) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -30,8 +31,12 @@ class ScriptedHostLink final : public HostLink {
     return true;
   }
   void publish(const Telemetry& t) noexcept override { last = t; }
-  std::uint32_t emergency_stops() const noexcept override { return estops; }
+  std::uint32_t emergency_stops() const noexcept override {
+    if (before_estops_read) before_estops_read();  // what the node's thread does at that instant
+    return estops;
+  }
 
+  std::function<void()> before_estops_read;
   std::uint32_t estops = 0;
   std::deque<HostTable> tables;
   std::deque<HostCommand> commands;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "app_bench.hpp"
 #include "firmware/drivers/cob_id.hpp"
@@ -165,6 +166,44 @@ TEST(ControlLoop, AnEstopSentBeforeAClearFaultIsAppliedBeforeIt) {
   b.host.estops = 2;
   b.cycle();
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
+}
+
+TEST(ControlLoop, AClearFaultQueuedJustBeforeAnEstopNeverUndoesIt) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  // The node's thread queues a clear-fault sent before any estop, then counts an
+  // estop, just as the loop reads the estop counter: the estop is the later order.
+  bool raced = false;
+  b.host.before_estops_read = [&] {
+    if (std::exchange(raced, true)) return;
+    b.host.commands.push_back({CommandKind::clear_fault, 0});  // estops_before 0
+    b.host.estops = 1;
+  };
+  for (int i = 0; i < 3; ++i) b.cycle();
+  ASSERT_TRUE(raced);
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop) << "the estop came last";
+  EXPECT_FALSE(b.has_event(AppEventKind::fault_cleared));
+}
+
+TEST(ControlLoop, AnEstopLatchedDuringBringUpKeepsTheDrivesStoppedUntilCleared) {
+  AppBench b;
+  ASSERT_EQ(b.loop->load_table(bench_table()), core::TableError::none);
+  b.host.estops = 1;  // an end cap that just restarted hears the operator's estop
+  b.cycle();
+  ASSERT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
+  ASSERT_TRUE(b.run_until([&] { return b.has_event(AppEventKind::bring_up_done); }, 500)) << "the nodes come up";
+  for (int i = 0; i < 200; ++i) b.cycle();
+  EXPECT_NE(b.drive0.state(), Cia402State::operation_enabled) << "the bring-up did not enable them";
+  EXPECT_NE(b.drive1.state(), Cia402State::operation_enabled);
+  EXPECT_FALSE(b.host.last.drives_enabled);
+  EXPECT_FALSE(b.running());
+  EXPECT_FALSE(b.has_event(AppEventKind::bring_up_failed));
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
+  b.host.commands.push_back({CommandKind::clear_fault, 0});
+  ASSERT_TRUE(b.run_until([&] { return b.loop->drives_enabled(); }, 100)) << "cleared, they come up";
+  for (int i = 0; i < 300; ++i) b.cycle();  // past the reset grace
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
+  EXPECT_TRUE(b.host.last.drives_enabled);
 }
 
 TEST(ControlLoop, DrainBusStopsAtItsPerCycleBoundOnAFloodedBus) {

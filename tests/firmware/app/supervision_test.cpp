@@ -102,6 +102,20 @@ TEST(Supervision, StalePositionTripsAfterItsTimeout) {
   EXPECT_TRUE(b.loop->master().drive_heartbeat(1).alive) << "found before any heartbeat timeout";
 }
 
+TEST(Supervision, AStalePositionDoesNotHideADriveLeavingOperationEnabled) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  for (int i = 0; i < 20; ++i) b.cycle();
+  b.drive0.tpdo_on_sync = false;  // drive 0's positions stop: a milder fault, drives kept enabled
+  ASSERT_TRUE(b.run_until([&] { return b.loop->controller().fault() != FaultCause::none; }, 200));
+  ASSERT_EQ(b.loop->controller().fault(), FaultCause::stale_position);
+  b.drive1.on_connection_lost();  // then drive 1 drops out behind the end cap's back
+  for (int i = 0; i < 50; ++i) b.cycle();
+  EXPECT_EQ(b.loop->master().power_request(), PowerRequest::quick_stop) << "the drop is seen and quick-stops";
+  EXPECT_NE(b.drive1.state(), Cia402State::operation_enabled) << "not stepped back up unseen";
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::stale_position) << "the first cause stays the one reported";
+}
+
 TEST(Supervision, FreshPositionsAndSamplesNeverTrip) {
   AppBench b;
   ASSERT_TRUE(b.start_running());
