@@ -39,7 +39,10 @@ void add_status_command(CLI::App& app) {
                                           : ground::format_status_table(snap, now, expected);
       std::fputs(text.c_str(), stdout);
       std::fflush(stdout);
-      return ground::missing_endcaps(snap, expected);
+      std::vector<int> unheard = ground::missing_endcaps(snap, expected);
+      // Heard while listening, then silent: dead or cut off since.
+      for (const int e : ground::silent_endcaps(snap, now, expected)) unheard.push_back(e);
+      return unheard;
     };
     if (args->once) {
       wait_for_endcaps(*station, args->ground, false);
@@ -49,8 +52,10 @@ void add_status_command(CLI::App& app) {
         std::string list;
         for (const int e : missing) list += (list.empty() ? "" : ",") + std::to_string(e);
         char text[200];
-        std::snprintf(text, sizeof text, "status: no heartbeat within %.1f s from end cap(s) %s of --endcaps %s",
-                      args->ground.timeout_s, list.c_str(), args->ground.endcaps.c_str());
+        std::snprintf(text, sizeof text,
+                      "status: no heartbeat (or none for %.0f s) within %.1f s from end cap(s) %s of --endcaps %s",
+                      ground::Station::kHeardFreshS, args->ground.timeout_s, list.c_str(),
+                      args->ground.endcaps.c_str());
         throw CommandError(1, text);
       }
       return;

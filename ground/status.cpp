@@ -38,7 +38,21 @@ const char* fault_name(std::uint8_t fault) {
 
 namespace {
 bool is_expected(std::uint16_t expected, int endcap) { return (expected & (1U << endcap)) != 0; }
+
+double age_s(const EndcapStatus& s, std::int64_t now_ns) {
+  return static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9;
+}
+bool silent(const EndcapStatus& s, std::int64_t now_ns) { return s.seen && age_s(s, now_ns) > Station::kHeardFreshS; }
 }  // namespace
+
+std::vector<int> silent_endcaps(const std::array<EndcapStatus, kEndcapCount>& status, std::int64_t now_ns,
+                                std::uint16_t expected) {
+  std::vector<int> out;
+  for (int e = 0; e < kEndcapCount; ++e) {
+    if (is_expected(expected, e) && silent(status[static_cast<std::size_t>(e)], now_ns)) out.push_back(e);
+  }
+  return out;
+}
 
 std::vector<int> missing_endcaps(const std::array<EndcapStatus, kEndcapCount>& status, std::uint16_t expected) {
   std::vector<int> out;
@@ -71,11 +85,11 @@ std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& st
       const auto& t = s.telemetry.tension_n();
       std::snprintf(tensions, sizeof tensions, "%.0f/%.0f", t[0], t[1]);
     }
-    std::snprintf(
-        line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s\n", e,
-        static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9, policy.c_str(), mode_name(hb.mode()),
-        fault_name(hb.fault()), tensions, hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
-        hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0, hb.host_lost() ? "LOST" : "ok");
+    std::snprintf(line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s%s\n", e, age_s(s, now_ns),
+                  policy.c_str(), mode_name(hb.mode()), fault_name(hb.fault()), tensions,
+                  hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
+                  hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0,
+                  hb.host_lost() ? "LOST" : "ok", silent(s, now_ns) ? "  SILENT" : "");
     out += line;
   }
   return out;
@@ -90,7 +104,8 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
     nlohmann::json j{{"endcap", e}, {"seen", s.seen}};
     if (s.seen) {
       const auto& hb = s.heartbeat;
-      j["heartbeat_age_s"] = static_cast<double>(now_ns - s.heartbeat_host_ns) / 1e9;
+      j["heartbeat_age_s"] = age_s(s, now_ns);
+      j["heard"] = !silent(s, now_ns);
       j["active_policy"] = hb.active_policy_id().to_string();
       j["active_policy_version"] = hb.active_policy_version();
       j["state"] = mode_name(hb.mode());
@@ -112,7 +127,10 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
     }
     endcaps.push_back(j);
   }
-  return nlohmann::json{{"endcaps", endcaps}, {"missing", missing_endcaps(status, expected)}}.dump(2);
+  return nlohmann::json{{"endcaps", endcaps},
+                        {"missing", missing_endcaps(status, expected)},
+                        {"silent", silent_endcaps(status, now_ns, expected)}}
+      .dump(2);
 }
 
 }  // namespace tensegrity::ground

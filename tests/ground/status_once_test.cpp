@@ -57,6 +57,27 @@ TEST(StatusFormat, ShowsOnlyTheExpectedEndcapsAndNamesTheMissingOnes) {
   EXPECT_EQ(json::parse(format_status_json(status, 0))["endcaps"].size(), 12U);
 }
 
+TEST(StatusFormat, AnEndcapNotHeardLatelyIsMarkedSilentNotShownAsItWas) {
+  auto status = seen({0, 1});
+  const std::int64_t now_ns = 10'000'000'000;
+  status[0].heartbeat_host_ns = now_ns - 500'000'000;    // 0.5 s ago: heard
+  status[1].heartbeat_host_ns = now_ns - 2'500'000'000;  // 2.5 s ago: past Station::kHeardFreshS
+  EXPECT_EQ(silent_endcaps(status, now_ns, 0b11), std::vector<int>{1});
+  EXPECT_TRUE(silent_endcaps(status, now_ns, 0b01).empty()) << "only the expected ones";
+  const std::string table = format_status_table(status, now_ns, 0b11);
+  const auto row = [&](int e) {
+    const std::size_t at = table.find("\n     " + std::to_string(e) + " ");
+    return table.substr(at + 1, table.find('\n', at + 1) - at - 1);
+  };
+  EXPECT_EQ(row(0).find("SILENT"), std::string::npos) << table;
+  EXPECT_NE(row(1).find("SILENT"), std::string::npos) << table;
+  const json j = json::parse(format_status_json(status, now_ns, 0b11));
+  EXPECT_EQ(j["endcaps"][0]["heard"], true);
+  EXPECT_EQ(j["endcaps"][1]["heard"], false);
+  EXPECT_EQ(j["silent"], json::array({1}));
+  EXPECT_EQ(j["missing"], json::array());
+}
+
 class StatusOnce : public ::testing::Test {
  protected:
   void SetUp() override {
