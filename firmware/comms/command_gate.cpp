@@ -27,6 +27,14 @@ GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clo
     d.reason = a->reason;
     return d;
   }
+  // An emergency stop is taken from any format version: a stop is the one order that
+  // is safe to act on whatever a newer or older tool meant by the rest of the sample,
+  // and refusing it would leave the motors running on a version mismatch.
+  if (c.kind == static_cast<std::uint8_t>(WireCommandKind::emergency_stop)) {
+    d.verdict = GateVerdict::deliver;
+    d.kind = WireCommandKind::emergency_stop;
+    return d;
+  }
   d.verdict = GateVerdict::refuse;
   if (c.format_version != format_version_) {
     d.reason = CommandReason::wrong_format_version;
@@ -37,10 +45,6 @@ GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clo
     return d;
   }
   d.kind = static_cast<WireCommandKind>(c.kind);
-  if (d.kind == WireCommandKind::emergency_stop) {
-    d.verdict = GateVerdict::deliver;
-    return d;
-  }
   if (const WriterState* w = find_writer(c.writer); w != nullptr && seq_newer(w->newest_seq, c.seq)) {
     d.reason = CommandReason::out_of_order;
     return d;

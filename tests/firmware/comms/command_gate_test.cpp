@@ -72,6 +72,20 @@ TEST(CommandGate, RefusesOtherFormatVersionsAndUnknownKinds) {
   EXPECT_EQ(d.reason, CommandReason::unknown_kind);
 }
 
+TEST(CommandGate, AnEstopIsTakenFromAnyFormatVersion) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  for (const std::uint16_t version : {std::uint16_t{kVersion - 1}, std::uint16_t{kVersion + 1}, std::uint16_t{0}}) {
+    CommandSample c = command(WireCommandKind::emergency_stop, 10U + version);
+    c.format_version = version;
+    const GateDecision d = handle(gate, c);
+    EXPECT_EQ(d.verdict, GateVerdict::deliver) << "version " << version;
+    EXPECT_EQ(d.kind, WireCommandKind::emergency_stop);
+  }
+  CommandSample clear = command(WireCommandKind::clear_fault, 50);
+  clear.format_version = kVersion + 1;
+  EXPECT_EQ(handle(gate, clear).reason, CommandReason::wrong_format_version) << "every other order is refused";
+}
+
 TEST(CommandGate, OlderSequenceFromTheSameWriterIsOutOfOrderButAnEstopAlwaysPasses) {
   CommandGate gate(0, kVersion, kMaxAge);
   EXPECT_EQ(handle(gate, command(WireCommandKind::clear_fault, 100)).verdict, GateVerdict::deliver);
