@@ -179,8 +179,11 @@ TEST(ControlLoop, AClearFaultQueuedJustBeforeAnEstopNeverUndoesIt) {
     b.host.commands.push_back({CommandKind::clear_fault, 0});  // estops_before 0
     b.host.estops = 1;
   };
-  for (int i = 0; i < 3; ++i) b.cycle();
+  b.cycle();
   ASSERT_TRUE(raced);
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop) << "latched in the cycle that read it";
+  EXPECT_EQ(b.loop->master().power_request(), canopen::PowerRequest::quick_stop);
+  for (int i = 0; i < 3; ++i) b.cycle();
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop) << "the estop came last";
   EXPECT_FALSE(b.has_event(AppEventKind::fault_cleared));
 }

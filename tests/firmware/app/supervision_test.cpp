@@ -110,8 +110,10 @@ TEST(Supervision, AStalePositionDoesNotHideADriveLeavingOperationEnabled) {
   ASSERT_TRUE(b.run_until([&] { return b.loop->controller().fault() != FaultCause::none; }, 200));
   ASSERT_EQ(b.loop->controller().fault(), FaultCause::stale_position);
   b.drive1.on_connection_lost();  // then drive 1 drops out behind the end cap's back
-  for (int i = 0; i < 50; ++i) b.cycle();
+  b.cycle();                      // its TPDO1 says so at this SYNC ...
+  b.cycle();                      // ... read in this cycle, as with no other fault latched
   EXPECT_EQ(b.loop->master().power_request(), PowerRequest::quick_stop) << "the drop is seen and quick-stops";
+  for (int i = 0; i < 50; ++i) b.cycle();
   EXPECT_NE(b.drive1.state(), Cia402State::operation_enabled) << "not stepped back up unseen";
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::stale_position) << "the first cause stays the one reported";
 }
