@@ -83,7 +83,10 @@ void ControlLoop::latch(FaultCause cause, std::int64_t time_ns) {
   // then hold with power on), also when a milder fault is latched already. Sensor
   // faults (a stale position included: the drive is alive, its heartbeat watched)
   // and over-tension keep the drives enabled, holding the last measured position.
-  if (quick_stops(cause)) master_.request_power(PowerRequest::quick_stop);
+  if (quick_stops(cause)) {
+    master_.request_power(PowerRequest::quick_stop);
+    quick_stop_latched_ = true;  // also under a milder fault latched first
+  }
   if (!first) return;
   pending_start_ = false;
   hold_at_measured();
@@ -171,6 +174,7 @@ void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns
       if (controller_.fault() == FaultCause::none) break;
       const FaultCause was = controller_.fault();
       controller_.clear_fault();
+      quick_stop_latched_ = false;
       hold_at_measured();
       master_.request_fault_reset();
       master_.request_power(PowerRequest::operation_enabled);
@@ -255,7 +259,7 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
   latch(cause, time_ns);
   // A stop latched before or during a bring-up outlasts it: the bring-up's own
   // request to enable the drives must not undo an operator's stop.
-  if (quick_stops(controller_.fault())) master_.request_power(PowerRequest::quick_stop);
+  if (quick_stop_latched_) master_.request_power(PowerRequest::quick_stop);
 
   // The newest valid reading per motor; a channel that stays invalid trips
   // sensor_timeout above, so holding the last value bridges single bad samples only.

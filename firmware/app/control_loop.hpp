@@ -162,6 +162,7 @@ class ControlLoop {
   core::TableError table_ack_error_ = core::TableError::none;
   std::uint32_t estops_seen_ = 0;
   std::uint32_t host_loss_stops_seen_ = 0;
+  bool quick_stop_latched_ = false;  // a quick-stopping cause latched, first or not, until cleared
 
   // Realtime pacing.
   bool timer_started_ = false;

@@ -168,6 +168,27 @@ TEST(ControlLoop, AnEstopSentBeforeAClearFaultIsAppliedBeforeIt) {
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::emergency_stop);
 }
 
+TEST(ControlLoop, AnEstopOnTopOfAMilderFaultAlsoOutlastsTheBringUp) {
+  AppBench b;
+  ASSERT_EQ(b.loop->load_table(bench_table()), core::TableError::none);
+  b.cycle();
+  CanFrame emcy;  // the load cell reports an error while the nodes come up: a fault that keeps drives enabled
+  emcy.id = canopen::cob_id(canopen::Function::sync_or_emcy, 4);
+  emcy.dlc = 8;
+  emcy.data[1] = 0x50;  // 0x5000, device hardware
+  b.bus.inject_to_receiver(emcy);
+  b.cycle();
+  ASSERT_EQ(b.loop->controller().fault(), FaultCause::sensor_timeout);
+  b.host.estops = 1;  // then the operator's estop: the first cause stays the one reported
+  b.cycle();
+  EXPECT_EQ(b.loop->master().power_request(), canopen::PowerRequest::quick_stop) << "in the cycle that reads it";
+  ASSERT_TRUE(b.run_until([&] { return b.has_event(AppEventKind::bring_up_done); }, 500));
+  for (int i = 0; i < 200; ++i) b.cycle();
+  EXPECT_NE(b.drive0.state(), Cia402State::operation_enabled) << "the bring-up did not enable them";
+  EXPECT_NE(b.drive1.state(), Cia402State::operation_enabled);
+  EXPECT_FALSE(b.host.last.drives_enabled);
+}
+
 TEST(ControlLoop, AClearFaultQueuedJustBeforeAnEstopNeverUndoesIt) {
   AppBench b;
   ASSERT_TRUE(b.start_running());
