@@ -26,7 +26,7 @@ class StationKeeper {
     double stall_s = 8.0;
     double trial_s = 20.0;
     double max_stall_s = 120.0;
-    double fresh_s = 2.0;  // an end cap is heard while its heartbeat is this recent
+    double fresh_s = Station::kHeardFreshS;  // an end cap is heard while its heartbeat is this recent
   };
   using MakeStation = std::function<std::unique_ptr<Station>()>;
 
