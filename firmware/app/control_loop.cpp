@@ -178,7 +178,7 @@ void ControlLoop::apply_command(const HostCommand& command, std::int64_t time_ns
       hold_at_measured();
       master_.request_fault_reset();
       master_.request_power(PowerRequest::operation_enabled);
-      grace_until_ns_ = time_ns + settings_.fault_reset_grace_ns;
+      safety_.begin_fault_reset(time_ns + settings_.fault_reset_grace_ns);
       // A node that rebooted while lost is pre-operational again: bring it up anew.
       bool all_operational =
           master_.heartbeat(NodeRole::load_cell).state == NmtState::operational || !settings_.master.use_load_cell;
@@ -252,11 +252,7 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
   handle_host(time_ns);
 
   const bool armed = master_.bring_up_step() == BringUpStep::done;
-  FaultCause cause = safety_.check(master_, time_ns, armed);
-  // The fault-reset handshake passes through states other than operation enabled.
-  const bool resetting = cause == FaultCause::drive_fault || cause == FaultCause::drive_disabled;
-  if (resetting && time_ns < grace_until_ns_) cause = FaultCause::none;
-  latch(cause, time_ns);
+  latch(safety_.check(master_, time_ns, armed), time_ns);
   // A stop latched before or during a bring-up outlasts it: the bring-up's own
   // request to enable the drives must not undo an operator's stop.
   if (quick_stop_latched_) master_.request_power(PowerRequest::quick_stop);

@@ -157,7 +157,6 @@ class ControlLoop {
   bool pending_start_ = false;
   std::int64_t pending_start_ns_ = 0;
   bool started_on_boot_ = false;
-  std::int64_t grace_until_ns_ = 0;
   std::uint32_t table_ack_sequence_ = 0;
   core::TableError table_ack_error_ = core::TableError::none;
   std::uint32_t estops_seen_ = 0;

@@ -51,7 +51,8 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   was_armed_ = armed;
   if (!armed) return FaultCause::none;
 
-  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+  const bool resetting = now_ns < reset_until_ns_;
+  for (std::size_t i = 0; i < master.drive_count() && !resetting; ++i) {
     const Cia402State s = master.drive(i).state;
     if (s == Cia402State::fault || s == Cia402State::fault_reaction_active) return FaultCause::drive_fault;
   }
@@ -61,7 +62,7 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   // Every drive is checked for the faults that quick-stop before any for a milder
   // one: a stale position latched on one drive must not hide another leaving
   // operation enabled, which would otherwise be stepped back up unseen.
-  const bool enable_wanted = master.power_request() == canopen::PowerRequest::operation_enabled;
+  const bool enable_wanted = master.power_request() == canopen::PowerRequest::operation_enabled && !resetting;
   for (std::size_t i = 0; i < master.drive_count(); ++i) {
     if (enable_wanted && master.drive(i).state != Cia402State::operation_enabled) return FaultCause::drive_disabled;
   }

@@ -34,6 +34,10 @@ class SafetyMonitor {
   core::FaultCause on_event(const canopen::MasterEvent& event, const canopen::CanopenMaster& master);
   // After the events: conditions that persist. `armed`: bring-up is done.
   core::FaultCause check(const canopen::CanopenMaster& master, std::int64_t now_ns, bool armed);
+  // A clear-fault's reset handshake walks the drives through states other than
+  // operation enabled: until `until_ns` their power state is not judged, while
+  // every other check (heartbeats, positions, load cell) goes on.
+  void begin_fault_reset(std::int64_t until_ns) { reset_until_ns_ = until_ns; }
 
   // Last time each load-cell channel delivered a fresh, valid sample.
   std::int64_t channel_fresh_ns(std::uint32_t channel) const { return fresh_ns_[channel]; }
@@ -47,6 +51,7 @@ class SafetyMonitor {
   bool was_armed_ = false;
   std::int64_t fresh_ns_[2] = {0, 0};
   std::int64_t armed_ns_ = 0;  // positions are judged from here at the earliest
+  std::int64_t reset_until_ns_ = 0;
 };
 
 }  // namespace tensegrity::fw::app

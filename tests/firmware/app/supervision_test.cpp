@@ -118,6 +118,33 @@ TEST(Supervision, AStalePositionDoesNotHideADriveLeavingOperationEnabled) {
   EXPECT_EQ(b.loop->controller().fault(), FaultCause::stale_position) << "the first cause stays the one reported";
 }
 
+TEST(Supervision, AStalePositionIsSeenWhileAClearedDriveIsStillComingUp) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  for (int i = 0; i < 20; ++i) b.cycle();
+  b.drive0.on_connection_lost();
+  b.cycle();
+  b.cycle();
+  ASSERT_EQ(b.loop->controller().fault(), FaultCause::drive_disabled);
+  // Drive 0 cannot reach operation enabled after the clear (held at its enable
+  // gate); its power state is not judged during the reset grace. Drive 1's
+  // positions stop meanwhile: that must trip within its own timeout, not when
+  // the grace ends.
+  b.drive0.hold_enable = true;
+  b.host.commands.push_back({CommandKind::clear_fault, 0});
+  b.cycle();
+  ASSERT_EQ(b.loop->controller().fault(), FaultCause::none);
+  b.drive1.tpdo_on_sync = false;
+  b.cycle();
+  const std::int64_t last_ns = b.loop->master().drive(1).position_updated_ns;
+  ASSERT_TRUE(b.run_until([&] { return b.loop->controller().fault() != FaultCause::none; }, 400));
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::stale_position);
+  const std::int64_t age_ns = b.loop->status().time_ns - last_ns;
+  EXPECT_LE(age_ns, b.settings.safety.drive_position_timeout_ns + b.settings.period_ns);
+  EXPECT_LT(age_ns, b.settings.fault_reset_grace_ns / 2) << "found inside the grace";
+  EXPECT_NE(b.drive0.state(), Cia402State::operation_enabled);
+}
+
 TEST(Supervision, FreshPositionsAndSamplesNeverTrip) {
   AppBench b;
   ASSERT_TRUE(b.start_running());
