@@ -134,7 +134,10 @@ void add_estop_command(CLI::App& app) {
 }
 
 void add_clear_fault_command(CLI::App& app) {
-  add_command(app, "clear-fault", "Clear latched faults; end caps return to idle and must be started again",
+  add_command(app, "clear-fault",
+              "Clear latched faults; end caps return to idle and must be started again. Waits (up to 8 s) to hear "
+              "each end cap first; one that took an emergency stop this tool had not heard of refuses "
+              "(estop_unseen): look again, then clear",
               ground::CommandKind::clear_fault, 15.0);
 }
 

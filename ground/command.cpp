@@ -2,6 +2,7 @@
 #include "ground/command.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <stdexcept>
 
@@ -46,6 +47,25 @@ CommandReport unanswered(CommandKind kind, std::int64_t start_host_time_ns, std:
   }
   return report;
 }
+
+// Command_::estops_seen for a clear-fault, once every addressed end cap was heard
+// or kClearHearWaitS passed; false when options.keep_going ended the wait (an
+// operator console's estop must not queue behind a clear waiting for a dead end cap).
+bool name_estops_seen(const Station& station, const CommandOptions& options, msg::Command_& cmd) {
+  constexpr std::int64_t kSliceNs = 20'000'000;
+  const double wait_s = std::min(kClearHearWaitS, options.timeout_s / 2);
+  const std::int64_t until = Station::now_ns() + static_cast<std::int64_t>(wait_s * 1e9);
+  for (;;) {
+    if (options.keep_going && !options.keep_going()) return false;
+    const std::int64_t slice = std::min(until, Station::now_ns() + kSliceNs);
+    if (station.wait_for_endcaps(options.endcap_mask, false, slice) || Station::now_ns() >= until) break;
+  }
+  const auto status = station.snapshot();
+  std::array<std::uint32_t, kEndcapCount> seen{};
+  for (std::size_t e = 0; e < seen.size(); ++e) seen[e] = status[e].estops_received;
+  cmd.estops_seen(seen);
+  return true;
+}
 }  // namespace
 
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
@@ -63,12 +83,17 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
   cmd.kind(static_cast<std::uint8_t>(kind));
   cmd.endcap_mask(options.endcap_mask);
   cmd.start_host_time_ns(start_host_time_ns);
+  const std::int64_t begin = Station::now_ns();
+  CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
+  if (kind == CommandKind::clear_fault && !name_estops_seen(station, options, cmd)) {
+    report.preempted = true;
+    return report;
+  }
   const std::int64_t start = Station::now_ns();
   cmd.issued_host_time_ns(start);
 
-  CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
   station.take_command_acks();
-  const std::int64_t deadline = start + static_cast<std::int64_t>(options.timeout_s * 1e9);
+  const std::int64_t deadline = begin + static_cast<std::int64_t>(options.timeout_s * 1e9);
   const auto retry_ns = static_cast<std::int64_t>(options.retry_interval_s * 1e9);
   std::size_t outstanding = report.results.size();
   std::int64_t next_send = start;

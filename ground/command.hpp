@@ -49,6 +49,13 @@ struct CommandReport {
 };
 
 // `start_host_time_ns` (host clock, Station::now_ns) is used by start only.
+// A clear-fault names, per end cap, the emergency stops this station has heard it
+// take (Command_::estops_seen); an end cap that has taken one since refuses it. So
+// it first waits, up to kClearHearWaitS (and half the timeout), for a heartbeat from
+// every addressed end cap (a fresh secured tool needs ~6 s to authenticate with
+// twelve); one still unheard is named with 0 stops seen, and refuses the clear if
+// it has taken any.
+inline constexpr double kClearHearWaitS = 8.0;
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
                            const CommandOptions& options);
 

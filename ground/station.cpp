@@ -281,6 +281,9 @@ void StationListeners::command_acks(Station& s, dds::DataReader* r) {
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
     }
+    if (ack.endcap_id() >= 0 && ack.endcap_id() < kEndcapCount) {
+      s.status_[static_cast<std::size_t>(ack.endcap_id())].estops_received = ack.estops_received();
+    }
     if (s.command_acks_.size() >= Station::kMaxPendingAcks) s.command_acks_.erase(s.command_acks_.begin());
     s.command_acks_.push_back(ack);
     s.changed_.notify_all();
@@ -331,6 +334,7 @@ void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
     }
     e.seen = true;
     e.heartbeat = hb;
+    e.estops_received = hb.estops_received();
     e.heartbeat_host_ns = Station::now_ns();
     s.changed_.notify_all();
   }

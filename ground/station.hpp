@@ -56,6 +56,9 @@ struct EndcapStatus {
   std::uint64_t telemetry_count = 0;
   std::uint64_t telemetry_gaps = 0;  // samples missing by sequence number
   std::uint64_t refused = 0;         // samples with another message-format version
+  // Emergency stops the end cap has taken, from its latest heartbeat or command ack
+  // (whichever arrived last): what a clear-fault from this station says it has seen.
+  std::uint32_t estops_received = 0;
 };
 
 class Station {

@@ -19,7 +19,8 @@ const CommandGate::WriterState* CommandGate::find_writer(const WriterId& w) cons
   return nullptr;
 }
 
-GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clock) const {
+GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clock,
+                                std::uint32_t estops_received) const {
   GateDecision d;
   if (endcap_id_ < 0 || endcap_id_ > 15 || (c.endcap_mask & (1U << endcap_id_)) == 0) return d;
   if (const Answer* a = find_answer(c)) {
@@ -59,6 +60,10 @@ GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clo
       d.reason = CommandReason::stale;
       return d;
     }
+  }
+  if (d.kind == WireCommandKind::clear_fault && c.estops_seen != estops_received) {
+    d.reason = CommandReason::estop_unseen;
+    return d;
   }
   d.verdict = GateVerdict::deliver;
   return d;

@@ -16,6 +16,11 @@
 //    (a start at a stale time would start in the wrong phase). Stop and clear-fault
 //    are not judged by any clock: a peer that moves the end cap's clock must not be
 //    able to make them "stale".
+// 7. Clear-fault only: it names the emergency stops its sender had seen from this
+//    end cap (estops_seen); when the end cap has taken another since, the clear is
+//    refused (estop_unseen). Ordering (rule 5) is per writer, so without this a
+//    clear-fault from one tool, delayed on the link, could land after another
+//    tool's emergency stop and undo it.
 //
 // History: the end cap's command reader is VOLATILE, so a fresh end cap is never
 // handed the samples a writer kept from before it matched (msgs/qos_profiles.xml,
@@ -42,6 +47,7 @@ struct CommandSample {
   std::uint16_t endcap_mask = 0;
   std::int64_t start_host_time_ns = 0;
   std::int64_t issued_host_time_ns = 0;
+  std::uint32_t estops_seen = 0;  // this end cap's entry of Command_::estops_seen
 };
 
 enum class GateVerdict : std::uint8_t {
@@ -71,8 +77,9 @@ class CommandGate {
   CommandGate(int endcap_id, std::uint16_t format_version, std::int64_t max_age_ns)
       : endcap_id_(endcap_id), format_version_(format_version), max_age_ns_(max_age_ns) {}
 
-  // Rules 1-6. Does not change the gate: call record() with the final answer.
-  GateDecision judge(const CommandSample& c, const HostClockView& clock) const;
+  // Rules 1-7; `estops_received`: emergency stops this end cap has taken (rule 7).
+  // Does not change the gate: call record() with the final answer.
+  GateDecision judge(const CommandSample& c, const HostClockView& clock, std::uint32_t estops_received = 0) const;
   // Remembers the answer given to `c` (rule 2) and its seq as its writer's newest
   // (rule 5) when it was acted on or refused for what it said (not for ordering).
   void record(const CommandSample& c, CommandReason reason);

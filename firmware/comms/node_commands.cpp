@@ -19,7 +19,7 @@ namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
 
-CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info) {
+CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info, int endcap_id) {
   CommandSample c;
   const auto& guid = info.sample_identity.writer_guid();
   static_assert(sizeof(guid.guidPrefix.value) + sizeof(guid.entityId.value) == sizeof(WriterId));
@@ -31,6 +31,9 @@ CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info) {
   c.endcap_mask = cmd.endcap_mask();
   c.start_host_time_ns = cmd.start_host_time_ns();
   c.issued_host_time_ns = cmd.issued_host_time_ns();
+  if (endcap_id >= 0 && static_cast<std::size_t>(endcap_id) < cmd.estops_seen().size()) {
+    c.estops_seen = cmd.estops_seen()[static_cast<std::size_t>(endcap_id)];
+  }
   return c;
 }
 
@@ -49,7 +52,7 @@ void EndcapNode::on_commands(Dds& d) {
   dds::SampleInfo info;
   while (d.command->take_next_sample(&cmd, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
-    const CommandSample c = to_sample(cmd, info);
+    const CommandSample c = to_sample(cmd, info, config_.endcap_id);
     HostClockView clock;
     {
       std::lock_guard lock(mutex_);
@@ -58,7 +61,9 @@ void EndcapNode::on_commands(Dds& d) {
       clock.synced = clock.synced && host_now.has_value();
       clock.host_now_ns = host_now.value_or(0);
     }
-    const GateDecision decision = gate_.judge(c, clock);
+    // Only this thread counts estops (act_on, under receive_mutex_): the count judged
+    // is the one the clear would be applied after.
+    const GateDecision decision = gate_.judge(c, clock, estops_.load(std::memory_order_acquire));
     CommandReason reason = decision.reason;
     switch (decision.verdict) {
       case GateVerdict::not_addressed: continue;
@@ -109,6 +114,7 @@ void EndcapNode::send_command_ack(Dds& d, std::uint32_t seq, CommandReason reaso
   ack.accepted(reason == CommandReason::accepted);
   ack.reason(static_cast<std::uint8_t>(reason));
   ack.reason_text(describe(reason));
+  ack.estops_received(estops_.load(std::memory_order_acquire));
   d.command_ack->write(&ack);
   // During a rejoin's overlap the host may hear only the other participant (a muted old
   // one, or a new one not yet matched); the station takes the first ack of a sequence.

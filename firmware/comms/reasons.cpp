@@ -60,6 +60,8 @@ const char* describe(CommandReason reason) noexcept {
     case CommandReason::out_of_order: return "older than a command this writer already sent: not acted on";
     case CommandReason::stale: return "start issued too long ago (host time): not acted on";
     case CommandReason::bad_time: return "start time outside the valid range";
+    case CommandReason::estop_unseen:
+      return "an emergency stop reached this end cap after the sender last heard it: look again, then clear";
   }
   return "unknown reason";
 }

@@ -40,6 +40,7 @@ enum class CommandReason : std::uint8_t {
   out_of_order = 6,      // older than a command this writer already sent: not acted on
   stale = 7,             // a start issued longer ago than command_max_age_s (host time)
   bad_time = 8,          // a start's host time is outside the valid range
+  estop_unseen = 9,      // a clear-fault sent before an emergency stop it had not seen
 };
 
 const char* describe(PolicyReason reason) noexcept;

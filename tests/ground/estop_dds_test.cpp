@@ -258,6 +258,65 @@ TEST_F(Estop, AFreshEndcapIgnoresCommandsLeftInAWritersHistory) {
   expect_all_within("ESTOPPED", sent, kBoundNs);
 }
 
+// Two tools: A issues a clear-fault that is held up on its way (written here only
+// later), B's emergency stop lands meanwhile. Per-writer ordering cannot tell the
+// two apart; the count of estops the clear names (what A had heard) can: every end
+// cap refuses it and stays stopped. A clear from a tool that has heard the estop lands.
+TEST_F(Estop, AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt) {
+  constexpr int kDomain = 170;
+  start_nodes(kDomain, {"--quiet"});
+  StationOptions late_tool;
+  late_tool.domain = kDomain;
+  late_tool.name = "estop_test_late_tool";
+  Station a(late_tool);
+  ASSERT_TRUE(a.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));
+  msg::Command_ held;  // what send_command would have sent then: no estop seen yet
+  held.format_version(msgs::kFormatVersion);
+  held.seq(0x5eed0001);
+  held.kind(static_cast<std::uint8_t>(CommandKind::clear_fault));
+  held.endcap_mask(kAllEndcaps);
+  held.issued_host_time_ns(Station::now_ns());
+  for (const auto& e : a.snapshot()) ASSERT_EQ(e.estops_received, 0U);
+
+  StationOptions other;
+  other.domain = kDomain;
+  other.name = "estop_test_other_tool";
+  Station b(other);
+  ASSERT_TRUE(b.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));
+  CommandOptions o;
+  o.timeout_s = 10.0;
+  o.retry_interval_s = kEstopRetryIntervalS;
+  const std::int64_t sent = Station::now_ns();
+  const CommandReport estop = send_command(b, CommandKind::emergency_stop, 0, o);
+  ASSERT_TRUE(estop.all_accepted()) << format_command_report(estop);
+  expect_all_within("ESTOPPED", sent, kBoundNs);
+
+  const std::int64_t late = Station::now_ns();
+  a.take_command_acks();
+  a.write_command(held);
+  std::map<int, std::uint8_t> reasons;
+  while (reasons.size() < static_cast<std::size_t>(kEndcapCount) && Station::now_ns() - late < seconds(10)) {
+    a.wait_for_command_acks(Station::now_ns() + seconds(1));
+    for (const auto& ack : a.take_command_acks()) {
+      if (ack.seq() == held.seq()) reasons[ack.endcap_id()] = ack.reason();
+    }
+  }
+  ASSERT_EQ(reasons.size(), static_cast<std::size_t>(kEndcapCount));
+  for (const auto& [e, r] : reasons) {
+    EXPECT_EQ(static_cast<CommandReason>(r), CommandReason::estop_unseen) << "end cap " << e;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_TRUE(events("CLEARED", sent).empty()) << "the held clear undid the estop";
+  for (const auto& e : a.snapshot()) EXPECT_EQ(e.estops_received, 1U) << "learnt from the acks";
+
+  Station& c = station(kDomain);  // a third tool: it hears the end caps' counts before it clears
+  ASSERT_TRUE(c.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));
+  const std::int64_t cleared_sent = Station::now_ns();
+  const CommandReport clear = command(CommandKind::clear_fault);
+  ASSERT_TRUE(clear.all_accepted()) << format_command_report(clear);
+  expect_all_within("CLEARED", cleared_sent, kBoundNs);
+}
+
 // The stand-in for a DDS Security handshake stalled for good (docs/security.md): a
 // first station that hears no end cap (it sits on another domain). No ack comes for
 // stall_s, so send_command_rejoining replaces it with a fresh participant, and the

@@ -150,5 +150,36 @@ TEST(CommandGate, RemembersAnswersOfManyWritersWithinItsBounds) {
   EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 49, 39), kSynced).reason, CommandReason::out_of_order);
 }
 
+// Rule 7: a clear-fault from another writer, issued before an emergency stop it
+// had not seen, must not undo it; per-writer ordering cannot tell.
+TEST(CommandGate, AClearFaultThatHasNotSeenTheLatestEstopIsRefused) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
+  clear.estops_seen = 2;
+  const GateDecision late = gate.judge(clear, kSynced, 3);  // a third estop, from writer 2, landed first
+  EXPECT_EQ(late.verdict, GateVerdict::refuse);
+  EXPECT_EQ(late.reason, CommandReason::estop_unseen);
+  gate.record(clear, late.reason);
+  EXPECT_EQ(gate.judge(clear, kSynced, 3).reason, CommandReason::estop_unseen) << "a retry gets the same answer";
+  // The sender looks again and clears with the count it now sees.
+  CommandSample again = command(WireCommandKind::clear_fault, 21, 1);
+  again.estops_seen = 3;
+  EXPECT_EQ(handle(gate, again).verdict, GateVerdict::refuse) << "the count judged is the end cap's: 0 here";
+  again.seq = 22;
+  EXPECT_EQ(gate.judge(again, kSynced, 3).verdict, GateVerdict::deliver);
+  // A count from before the end cap restarted (higher than its own) is not a match either.
+  EXPECT_EQ(gate.judge(again, kSynced, 1).reason, CommandReason::estop_unseen);
+}
+
+TEST(CommandGate, OnlyAClearFaultIsJudgedByTheEstopsItHasSeen) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  std::uint32_t seq = 30;
+  for (const WireCommandKind kind : {WireCommandKind::start, WireCommandKind::stop, WireCommandKind::emergency_stop}) {
+    CommandSample c = command(kind, seq++);
+    c.estops_seen = 0;
+    EXPECT_EQ(gate.judge(c, kSynced, 7).verdict, GateVerdict::deliver) << static_cast<int>(kind);
+  }
+}
+
 }  // namespace
 }  // namespace tensegrity::fw::comms
