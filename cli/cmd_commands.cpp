@@ -71,6 +71,15 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
   if (reply->error.empty() && (reported & request.endcap_mask) != request.endcap_mask) {
     reply->error = "its report leaves out end caps this command addresses";
   }
+  if (reply->error.empty() && reply->report.preempted && none_acked && kind == ground::CommandKind::clear_fault) {
+    // Sent again from here it would name the estops counted after one that took over,
+    // and undo it: the operator must see that estop first.
+    std::printf("%s", ground::format_command_report(reply->report).c_str());
+    throw CommandError(1, name +
+                              ": the console ended it before it went out (an emergency stop took over, or the "
+                              "console is stopping); not sent: look at the end caps (tensegrity status), then clear "
+                              "again");
+  }
   if (!reply->error.empty() || (reply->report.preempted && none_acked)) {
     // Refused (busy, stopping) or ended before any end cap answered: the command may
     // not have gone out, so on the default socket the tool sends it itself.

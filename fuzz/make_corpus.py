@@ -99,7 +99,9 @@ def command(kind, seq=1, mask=0xFFF, start=0, issued=1_000_000_000):
     c = Cdr()
     c.u16(format_version()); c.u32(seq); c.u8(kind); c.u16(mask); c.i64(start); c.i64(issued)
     for e in range(12):
-        c.u32(e % 3 if kind == 3 else 0)  # estops_seen: a clear-fault names what it saw
+        c.u32(0x5eed0000 + e if kind == 3 else 0)  # lives_seen: a clear-fault names what it saw
+    for e in range(12):
+        c.u32(e % 3 if kind == 3 else 0)  # estops_seen
     return c.payload()
 
 

@@ -2,7 +2,6 @@
 #include "ground/command.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cstdio>
 #include <stdexcept>
 
@@ -48,24 +47,6 @@ CommandReport unanswered(CommandKind kind, std::int64_t start_host_time_ns, std:
   return report;
 }
 
-// Command_::estops_seen for a clear-fault, once every addressed end cap was heard
-// or kClearHearWaitS passed; false when options.keep_going ended the wait (an
-// operator console's estop must not queue behind a clear waiting for a dead end cap).
-bool name_estops_seen(const Station& station, const CommandOptions& options, msg::Command_& cmd) {
-  constexpr std::int64_t kSliceNs = 20'000'000;
-  const double wait_s = std::min(kClearHearWaitS, options.timeout_s / 2);
-  const std::int64_t until = Station::now_ns() + static_cast<std::int64_t>(wait_s * 1e9);
-  for (;;) {
-    if (options.keep_going && !options.keep_going()) return false;
-    const std::int64_t slice = std::min(until, Station::now_ns() + kSliceNs);
-    if (station.wait_for_endcaps(options.endcap_mask, false, slice) || Station::now_ns() >= until) break;
-  }
-  const auto status = station.snapshot();
-  std::array<std::uint32_t, kEndcapCount> seen{};
-  for (std::size_t e = 0; e < seen.size(); ++e) seen[e] = status[e].estops_received;
-  cmd.estops_seen(seen);
-  return true;
-}
 }  // namespace
 
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
@@ -85,9 +66,18 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
   cmd.start_host_time_ns(start_host_time_ns);
   const std::int64_t begin = Station::now_ns();
   CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
-  if (kind == CommandKind::clear_fault && !name_estops_seen(station, options, cmd)) {
-    report.preempted = true;
-    return report;
+  if (kind == CommandKind::clear_fault) {
+    EstopsSeen own;
+    EstopsSeen& seen =
+        options.estops_seen ? *options.estops_seen : (own = estops_seen_now(station, options.endcap_mask));
+    const std::int64_t send_ns = static_cast<std::int64_t>(std::max(0.0, options.timeout_s - kClearSendS) * 1e9);
+    const std::int64_t until =
+        std::min(station.started_ns() + static_cast<std::int64_t>(kClearHearWaitS * 1e9), begin + send_ns);
+    if (!hear_unknown(station, options.endcap_mask, until, seen, options.keep_going)) {
+      report.preempted = true;
+      return report;
+    }
+    seen.write_to(cmd);
   }
   const std::int64_t start = Station::now_ns();
   cmd.issued_host_time_ns(start);
@@ -116,6 +106,7 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
     const std::int64_t arrived = Station::now_ns();
     for (const auto& ack : station.take_command_acks()) {
       if (ack.seq() != cmd.seq()) continue;
+      station.note_estops(ack.endcap_id(), {ack.life_id(), ack.estops_received()});
       for (auto& r : report.results) {
         if (r.endcap != ack.endcap_id() || r.acked) continue;
         r.acked = true;
@@ -140,12 +131,21 @@ CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandK
   const std::int64_t deadline = start + static_cast<std::int64_t>(options.timeout_s * 1e9);
   CommandReport report = unanswered(kind, start_host_time_ns, options.endcap_mask);
   std::uint16_t missing = options.endcap_mask;
+  // One view for every slice: a later participant must not name estops taken since.
+  std::shared_ptr<EstopsSeen> seen = options.estops_seen;
+  if (kind == CommandKind::clear_fault && !seen) {
+    seen = std::make_shared<EstopsSeen>(estops_seen_now(*station, options.endcap_mask));
+  }
   for (;;) {
     // One slice: until the missing end caps acked, the deadline, or stall_s passed.
     const std::int64_t slice_start = Station::now_ns();
     CommandOptions slice = options;
     slice.endcap_mask = missing;
-    slice.timeout_s = std::min(rejoin.stall_s, static_cast<double>(deadline - slice_start) / 1e9);
+    slice.estops_seen = seen;
+    // A clear-fault first waits to hear the end caps (send_command): the stall clock
+    // starts after that.
+    const double hear_s = kind == CommandKind::clear_fault ? kClearHearWaitS : 0.0;
+    slice.timeout_s = std::min(rejoin.stall_s + hear_s, static_cast<double>(deadline - slice_start) / 1e9);
     if (!(slice.timeout_s > 0.0)) return report;
     bool progress = false;
     const CommandReport got_slice = send_command(*station, kind, start_host_time_ns, slice);

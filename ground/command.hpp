@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "firmware/comms/reasons.hpp"
+#include "ground/estops_seen.hpp"
 #include "ground/station.hpp"
 
 namespace tensegrity::ground {
@@ -24,6 +25,10 @@ struct CommandOptions {
   // When set, asked every few milliseconds: false ends the command early (an
   // operator station's emergency stop preempts a stop or clear-fault in flight).
   std::function<bool()> keep_going;
+  // Clear-fault: the end caps' estop counts as the operator's tool had heard them
+  // when asked (ground/estops_seen.hpp); end caps unknown there are filled in as they
+  // are first heard. Null: taken from the station when send_command starts.
+  std::shared_ptr<EstopsSeen> estops_seen;
 };
 // An emergency stop is re-sent more often: each retry is one more chance through a
 // lossy link, and an end cap answers a repeat without acting twice.
@@ -49,13 +54,14 @@ struct CommandReport {
 };
 
 // `start_host_time_ns` (host clock, Station::now_ns) is used by start only.
-// A clear-fault names, per end cap, the emergency stops this station has heard it
-// take (Command_::estops_seen); an end cap that has taken one since refuses it. So
-// it first waits, up to kClearHearWaitS (and half the timeout), for a heartbeat from
-// every addressed end cap (a fresh secured tool needs ~6 s to authenticate with
-// twelve); one still unheard is named with 0 stops seen, and refuses the clear if
-// it has taken any.
+// A clear-fault names, per end cap, the emergency stops the tool had heard it take
+// (options.estops_seen); an end cap that has taken one since refuses it. An end cap
+// not yet heard is waited for until kClearHearWaitS after the station was made (a
+// fresh secured tool needs ~6 s to authenticate with twelve; a long-running console
+// does not wait), leaving kClearSendS of the timeout to send; one still unheard then
+// refuses the clear.
 inline constexpr double kClearHearWaitS = 8.0;
+inline constexpr double kClearSendS = 2.0;
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,
                            const CommandOptions& options);
 

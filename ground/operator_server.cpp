@@ -71,6 +71,12 @@ void OperatorServer::shutdown() {
 
 CommandReport OperatorServer::run(const OperatorRequest& request) {
   const bool estop = request.kind == CommandKind::emergency_stop;
+  // What the operator's clear-fault has seen is what the console heard when it was
+  // asked, not after a command ahead of it (an estop landing meanwhile is unseen).
+  std::shared_ptr<EstopsSeen> seen;
+  if (request.kind == CommandKind::clear_fault) {
+    seen = std::make_shared<EstopsSeen>(estops_seen_now(*station_(), request.endcap_mask));
+  }
   if (estop) ++estops_waiting_;
   std::unique_lock lock(command_mutex_);
   if (estop) --estops_waiting_;
@@ -78,6 +84,7 @@ CommandReport OperatorServer::run(const OperatorRequest& request) {
   CommandOptions options;
   options.endcap_mask = request.endcap_mask;
   options.timeout_s = request.timeout_s;
+  options.estops_seen = seen;
   // Any command in flight, an older estop included, yields to a newer estop; the
   // end caps an estop had not yet heard from pass to the one that took over.
   options.keep_going = [this] { return estops_waiting_.load() == 0 && !stopping_.load(); };

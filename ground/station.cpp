@@ -29,6 +29,10 @@ namespace dds = eprosima::fastdds::dds;
 
 namespace {
 bool valid_endcap(int id) { return id >= 0 && id < kEndcapCount; }
+
+void merge_estops(fw::comms::EstopCount& known, const fw::comms::EstopCount& heard) {
+  if (heard.life_id != known.life_id || heard.count > known.count) known = heard;
+}
 }  // namespace
 
 // One listener per reader; each takes its samples in the receive thread.
@@ -281,9 +285,6 @@ void StationListeners::command_acks(Station& s, dds::DataReader* r) {
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
     }
-    if (ack.endcap_id() >= 0 && ack.endcap_id() < kEndcapCount) {
-      s.status_[static_cast<std::size_t>(ack.endcap_id())].estops_received = ack.estops_received();
-    }
     if (s.command_acks_.size() >= Station::kMaxPendingAcks) s.command_acks_.erase(s.command_acks_.begin());
     s.command_acks_.push_back(ack);
     s.changed_.notify_all();
@@ -318,6 +319,12 @@ void StationListeners::telemetry(Station& s, dds::DataReader* r) {
   }
 }
 
+void Station::note_estops(int endcap, const fw::comms::EstopCount& heard) {
+  if (endcap < 0 || endcap >= kEndcapCount) return;
+  std::lock_guard lock(mutex_);
+  merge_estops(status_[static_cast<std::size_t>(endcap)].estops, heard);
+}
+
 void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
   msg::Heartbeat_ hb;
   dds::SampleInfo info;
@@ -334,7 +341,7 @@ void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
     }
     e.seen = true;
     e.heartbeat = hb;
-    e.estops_received = hb.estops_received();
+    merge_estops(e.estops, {hb.life_id(), hb.estops_received()});
     e.heartbeat_host_ns = Station::now_ns();
     s.changed_.notify_all();
   }

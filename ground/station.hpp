@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "firmware/comms/estop_count.hpp"
 #include "tensegrity_msgs/msg/Command.h"
 #include "tensegrity_msgs/msg/CommandAck.h"
 #include "tensegrity_msgs/msg/Heartbeat.h"
@@ -56,9 +57,11 @@ struct EndcapStatus {
   std::uint64_t telemetry_count = 0;
   std::uint64_t telemetry_gaps = 0;  // samples missing by sequence number
   std::uint64_t refused = 0;         // samples with another message-format version
-  // Emergency stops the end cap has taken, from its latest heartbeat or command ack
-  // (whichever arrived last): what a clear-fault from this station says it has seen.
-  std::uint32_t estops_received = 0;
+  // Emergency stops the end cap has taken as this station heard them (heartbeats and
+  // acks of its own commands): what a clear-fault from it says it has seen. Within a
+  // life the highest count wins (a heartbeat read before an estop may arrive after
+  // its ack); a new life replaces it.
+  fw::comms::EstopCount estops;
 };
 
 class Station {
@@ -85,6 +88,12 @@ class Station {
   static constexpr std::size_t kMaxPendingAcks = 1024;
 
   std::array<EndcapStatus, kEndcapCount> snapshot() const;
+  // An end cap's estop count heard in an ack of a command this station sent
+  // (send_command calls it; acks of other tools' commands, or history, do not count).
+  void note_estops(int endcap, const fw::comms::EstopCount& heard);
+  // Host time at which this station's participant was made: end caps are discovered
+  // in the seconds after it (a clear-fault waits for them up to kClearHearWaitS).
+  std::int64_t started_ns() const { return started_ns_; }
   // The end caps whose heartbeat arrived at most `fresh_s` before `now_ns`, as a mask.
   // This station's own heartbeat names them (kHeardFreshS), so that an end cap that
   // hears the host but is not heard can tell and join again.
@@ -109,6 +118,7 @@ class Station {
   void heartbeat_loop();
 
   StationOptions options_;
+  std::int64_t started_ns_ = now_ns();
   std::unique_ptr<Dds> dds_;
   mutable std::mutex mutex_;
   mutable std::condition_variable changed_;

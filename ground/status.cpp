@@ -115,6 +115,7 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
       j["clock_round_trip_s"] = static_cast<double>(hb.clock_round_trip_ns()) / 1e9;
       j["host_lost"] = hb.host_lost();
       j["loop_overruns"] = hb.loop_overruns();
+      j["estops_received"] = s.estops.count;  // what a clear-fault from here would name
     }
     if (s.have_telemetry) {
       const auto& t = s.telemetry;

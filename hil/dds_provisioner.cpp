@@ -11,6 +11,7 @@
 #include <ctime>
 #include <limits>
 
+#include "firmware/core/fault.hpp"
 #include "firmware/core/table.hpp"
 #include "ground/command.hpp"
 #include "ground/keystore.hpp"
@@ -135,7 +136,8 @@ void DdsProvisioner::clear_faults_or_fail(std::uint16_t mask) {
           (why.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(status[e].heartbeat.fault()) + ")";
     }
   }
-  throw HilError("end cap(s) " + why + " still faulted after a clear-fault before the start");
+  throw HilError("end cap(s) " + why +
+                 " still faulted before the start (an emergency stop is left to the operator: tensegrity clear-fault)");
 }
 
 // 3. One start time for all. Lockstep: k ticks after the last SYNC (plus half the
@@ -239,6 +241,11 @@ bool DdsProvisioner::clear_faults_before_start(std::uint16_t mask, std::int64_t 
   for (int e = 0; e < ground::kEndcapCount; ++e) {
     const ground::EndcapStatus s = station_->snapshot()[e];
     if ((mask & (1U << e)) == 0 || !s.seen || s.heartbeat.fault() == 0) continue;
+    if (s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop)) {
+      // An operator's stop is theirs to clear, never the launcher's.
+      note("dds: end cap " + std::to_string(e) + " holds an emergency stop: not cleared by the launcher");
+      return false;
+    }
     faulted = static_cast<std::uint16_t>(faulted | (1U << e));
     which += (which.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(s.heartbeat.fault()) + ")";
   }
@@ -246,7 +253,11 @@ bool DdsProvisioner::clear_faults_before_start(std::uint16_t mask, std::int64_t 
   ground::CommandOptions co;
   co.endcap_mask = faulted;
   co.timeout_s = config_.command_timeout_s;
-  ground::send_command(*station_, ground::CommandKind::clear_fault, 0, co);
+  const ground::CommandReport report = ground::send_command(*station_, ground::CommandKind::clear_fault, 0, co);
+  if (!report.all_accepted()) {
+    note("dds: clear-fault for end cap(s) " + which + " not taken by all:\n" + ground::format_command_report(report));
+    return false;
+  }
   note("dds: end cap(s) " + which + " had latched a fault before the start: cleared (clear-fault)");
   // The heartbeat (5 Hz) says when it took; the drives may take a few cycles more.
   for (;;) {
@@ -336,7 +347,8 @@ void DdsProvisioner::supervise() {
                        "link's history)");
         continue;
       }
-      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0) {
+      // The clear names the estops this life took: wait for its own heartbeat.
+      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0 && s.heartbeat_host_ns > since) {
         // Latched while coming back (a sample late while the emulator served the
         // others): the same clear-fault as before the run's start.
         clear_faults_before_start(static_cast<std::uint16_t>(1U << e),

@@ -20,7 +20,7 @@ const CommandGate::WriterState* CommandGate::find_writer(const WriterId& w) cons
 }
 
 GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clock,
-                                std::uint32_t estops_received) const {
+                                const EstopCount& estops_taken) const {
   GateDecision d;
   if (endcap_id_ < 0 || endcap_id_ > 15 || (c.endcap_mask & (1U << endcap_id_)) == 0) return d;
   if (const Answer* a = find_answer(c)) {
@@ -61,7 +61,7 @@ GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clo
       return d;
     }
   }
-  if (d.kind == WireCommandKind::clear_fault && c.estops_seen != estops_received) {
+  if (d.kind == WireCommandKind::clear_fault && c.estops_seen != estops_taken) {
     d.reason = CommandReason::estop_unseen;
     return d;
   }

@@ -16,9 +16,9 @@
 //    (a start at a stale time would start in the wrong phase). Stop and clear-fault
 //    are not judged by any clock: a peer that moves the end cap's clock must not be
 //    able to make them "stale".
-// 7. Clear-fault only: it names the emergency stops its sender had seen from this
-//    end cap (estops_seen); when the end cap has taken another since, the clear is
-//    refused (estop_unseen). Ordering (rule 5) is per writer, so without this a
+// 7. Clear-fault only: it names the emergency stops its sender had seen this end
+//    cap take (its life id and count); when the end cap has taken another since, or
+//    it is another life, the clear is refused (estop_unseen). Ordering (rule 5) is per writer, so without this a
 //    clear-fault from one tool, delayed on the link, could land after another
 //    tool's emergency stop and undo it.
 //
@@ -31,6 +31,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "firmware/comms/estop_count.hpp"
 #include "firmware/comms/reasons.hpp"
 
 namespace tensegrity::fw::comms {
@@ -47,7 +48,7 @@ struct CommandSample {
   std::uint16_t endcap_mask = 0;
   std::int64_t start_host_time_ns = 0;
   std::int64_t issued_host_time_ns = 0;
-  std::uint32_t estops_seen = 0;  // this end cap's entry of Command_::estops_seen
+  EstopCount estops_seen;  // this end cap's entries of Command_::lives_seen / estops_seen
 };
 
 enum class GateVerdict : std::uint8_t {
@@ -77,9 +78,9 @@ class CommandGate {
   CommandGate(int endcap_id, std::uint16_t format_version, std::int64_t max_age_ns)
       : endcap_id_(endcap_id), format_version_(format_version), max_age_ns_(max_age_ns) {}
 
-  // Rules 1-7; `estops_received`: emergency stops this end cap has taken (rule 7).
-  // Does not change the gate: call record() with the final answer.
-  GateDecision judge(const CommandSample& c, const HostClockView& clock, std::uint32_t estops_received = 0) const;
+  // Rules 1-7; `estops_taken`: this end cap's own (rule 7). Does not change the
+  // gate: call record() with the final answer.
+  GateDecision judge(const CommandSample& c, const HostClockView& clock, const EstopCount& estops_taken) const;
   // Remembers the answer given to `c` (rule 2) and its seq as its writer's newest
   // (rule 5) when it was acted on or refused for what it said (not for ordering).
   void record(const CommandSample& c, CommandReason reason);

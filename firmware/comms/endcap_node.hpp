@@ -23,6 +23,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <random>
 #include <string>
 #include <thread>
 
@@ -155,6 +156,9 @@ class EndcapNode final : public app::HostLink {
   // cycles old there (lockstep runs its cycles faster than the node wakes).
   app::LatestValue<LoopClockPoint> loop_clock_in_;
   std::atomic<std::uint32_t> estops_{0};
+  // Drawn at start, never 0 (a host's value): names this life's estop count on the
+  // wire, so a clear-fault that saw an earlier life's count cannot match.
+  const std::uint32_t life_id_ = (std::random_device{}() | 1U);
   std::atomic<std::uint32_t> host_loss_stops_{0};
 
   // Node thread state.

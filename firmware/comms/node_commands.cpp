@@ -32,7 +32,8 @@ CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info, int
   c.start_host_time_ns = cmd.start_host_time_ns();
   c.issued_host_time_ns = cmd.issued_host_time_ns();
   if (endcap_id >= 0 && static_cast<std::size_t>(endcap_id) < cmd.estops_seen().size()) {
-    c.estops_seen = cmd.estops_seen()[static_cast<std::size_t>(endcap_id)];
+    c.estops_seen.life_id = cmd.lives_seen()[static_cast<std::size_t>(endcap_id)];
+    c.estops_seen.count = cmd.estops_seen()[static_cast<std::size_t>(endcap_id)];
   }
   return c;
 }
@@ -63,7 +64,7 @@ void EndcapNode::on_commands(Dds& d) {
     }
     // Only this thread counts estops (act_on, under receive_mutex_): the count judged
     // is the one the clear would be applied after.
-    const GateDecision decision = gate_.judge(c, clock, estops_.load(std::memory_order_acquire));
+    const GateDecision decision = gate_.judge(c, clock, {life_id_, estops_.load(std::memory_order_acquire)});
     CommandReason reason = decision.reason;
     switch (decision.verdict) {
       case GateVerdict::not_addressed: continue;
@@ -114,6 +115,7 @@ void EndcapNode::send_command_ack(Dds& d, std::uint32_t seq, CommandReason reaso
   ack.accepted(reason == CommandReason::accepted);
   ack.reason(static_cast<std::uint8_t>(reason));
   ack.reason_text(describe(reason));
+  ack.life_id(life_id_);
   ack.estops_received(estops_.load(std::memory_order_acquire));
   d.command_ack->write(&ack);
   // During a rejoin's overlap the host may hear only the other participant (a muted old

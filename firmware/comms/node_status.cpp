@@ -151,6 +151,7 @@ void EndcapNode::send_heartbeat(std::int64_t now) {
   hb.host_lost(host_lost_.load());
   hb.host_loss_action(static_cast<std::uint8_t>(config_.host_loss));
   hb.loop_overruns(last_telemetry_.telemetry.overruns);
+  hb.life_id(life_id_);
   hb.estops_received(estops_.load(std::memory_order_acquire));
   dds_->heartbeat->write(&hb);
 }

@@ -276,7 +276,11 @@ TEST_F(Estop, AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt) {
   held.kind(static_cast<std::uint8_t>(CommandKind::clear_fault));
   held.endcap_mask(kAllEndcaps);
   held.issued_host_time_ns(Station::now_ns());
-  for (const auto& e : a.snapshot()) ASSERT_EQ(e.estops_received, 0U);
+  estops_seen_now(a, kAllEndcaps).write_to(held);
+  for (std::size_t e = 0; e < kEndcapCount; ++e) {
+    ASSERT_NE(held.lives_seen()[e], 0U) << "end cap " << e << " heard: its life is named";
+    ASSERT_EQ(held.estops_seen()[e], 0U);
+  }
 
   StationOptions other;
   other.domain = kDomain;
@@ -307,7 +311,11 @@ TEST_F(Estop, AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt) {
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_TRUE(events("CLEARED", sent).empty()) << "the held clear undid the estop";
-  for (const auto& e : a.snapshot()) EXPECT_EQ(e.estops_received, 1U) << "learnt from the acks";
+  for (std::size_t e = 0; e < kEndcapCount; ++e) {
+    const fw::comms::EstopCount now = a.snapshot()[e].estops;
+    EXPECT_EQ(now.count, 1U) << "end cap " << e << ": heard since";
+    EXPECT_EQ(now.life_id, held.lives_seen()[e]) << "end cap " << e << ": the same life";
+  }
 
   Station& c = station(kDomain);  // a third tool: it hears the end caps' counts before it clears
   ASSERT_TRUE(c.wait_for_endcaps(kAllEndcaps, false, Station::now_ns() + seconds(15)));

@@ -20,6 +20,7 @@
 #include "ground/operator_server.hpp"
 #include "ground/station_keeper.hpp"
 #include "ground/unix_socket.hpp"
+#include "tests/ground/console_link_fixture.hpp"
 #include "tests/ground/subprocess.hpp"
 
 namespace tensegrity::ground {
@@ -81,34 +82,6 @@ TEST(OperatorProtocol, AReplyRoundTrips) {
   EXPECT_DOUBLE_EQ(got.report.results[0].latency_s, 0.004);
   EXPECT_THROW(decode_reply(R"({"format":"tensegrity-operator/1"})"), OperatorLinkError);
 }
-
-class ConsoleLink : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("console_" + std::to_string(std::random_device{}()));
-    fs::create_directories(dir_);
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::replace);  // a console's folder is private
-  }
-  void TearDown() override {
-    nodes_.reset();
-    fs::remove_all(dir_);
-  }
-  // End caps 0-2 (comms_test_node) on `domain`, and a station that hears them; null
-  // when either does not come up within 20 s.
-  std::shared_ptr<Station> three_endcaps(int domain) {
-    nodes_ = std::make_unique<Subprocess>(
-        std::vector<std::string>{COMMS_TEST_NODE, "--domain", std::to_string(domain), "--endcaps", "0-2"},
-        dir_ / "nodes.out", dir_ / "nodes.err");
-    if (!nodes_->wait_for_output("READY", std::chrono::seconds(20))) return nullptr;
-    StationOptions o;
-    o.domain = domain;
-    auto station = std::make_shared<Station>(o);
-    if (!station->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000)) return nullptr;
-    return station;
-  }
-  fs::path dir_;
-  std::unique_ptr<Subprocess> nodes_;
-};
 
 TEST_F(ConsoleLink, OneListenerPerSocketAndADeadOnesSocketIsReplaced) {
   const fs::path path = dir_ / "c.sock";

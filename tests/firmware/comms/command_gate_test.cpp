@@ -32,10 +32,11 @@ CommandSample command(WireCommandKind kind, std::uint32_t seq, std::uint8_t writ
 
 const HostClockView kSynced{true, 9'500'000'000};
 const HostClockView kNotSynced{};
+const EstopCount kNoEstops{};
 
 // Judges and records as the node does; returns the decision.
 GateDecision handle(CommandGate& gate, const CommandSample& c, const HostClockView& clock = kSynced) {
-  const GateDecision d = gate.judge(c, clock);
+  const GateDecision d = gate.judge(c, clock, kNoEstops);
   if (d.verdict == GateVerdict::refuse || d.verdict == GateVerdict::deliver) gate.record(c, d.reason);
   return d;
 }
@@ -44,20 +45,20 @@ TEST(CommandGate, IgnoresCommandsForOtherEndcaps) {
   CommandGate gate(3, kVersion, kMaxAge);
   CommandSample c = command(WireCommandKind::stop, 10);
   c.endcap_mask = 0x0FF7;  // all but 3
-  EXPECT_EQ(gate.judge(c, kSynced).verdict, GateVerdict::not_addressed);
+  EXPECT_EQ(gate.judge(c, kSynced, kNoEstops).verdict, GateVerdict::not_addressed);
   c.endcap_mask = 0x0008;
-  EXPECT_EQ(gate.judge(c, kSynced).verdict, GateVerdict::deliver);
+  EXPECT_EQ(gate.judge(c, kSynced, kNoEstops).verdict, GateVerdict::deliver);
 }
 
 TEST(CommandGate, ARetryGetsTheFirstAnswerAndIsNotActedOnAgain) {
   CommandGate gate(0, kVersion, kMaxAge);
   const CommandSample c = command(WireCommandKind::stop, 10);
   EXPECT_EQ(handle(gate, c).verdict, GateVerdict::deliver);
-  const GateDecision again = gate.judge(c, kSynced);
+  const GateDecision again = gate.judge(c, kSynced, kNoEstops);
   EXPECT_EQ(again.verdict, GateVerdict::repeat);
   EXPECT_EQ(again.reason, CommandReason::accepted);
   // The same seq from another writer is another command.
-  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 10, 2), kSynced).verdict, GateVerdict::deliver);
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 10, 2), kSynced, kNoEstops).verdict, GateVerdict::deliver);
 }
 
 TEST(CommandGate, RefusesOtherFormatVersionsAndUnknownKinds) {
@@ -122,7 +123,7 @@ TEST(CommandGate, OnlyAStartIsJudgedByTheClock) {
     EXPECT_EQ(handle(gate, command(kind, ++seq), moved).verdict, GateVerdict::deliver) << static_cast<int>(kind);
   }
   // Before the first sync nothing is stale (the start is refused later, unsynced).
-  EXPECT_EQ(gate.judge(command(WireCommandKind::start, 100), kNotSynced).verdict, GateVerdict::deliver);
+  EXPECT_EQ(gate.judge(command(WireCommandKind::start, 100), kNotSynced, kNoEstops).verdict, GateVerdict::deliver);
 }
 
 TEST(CommandGate, StartTimesOutsideTheWireRangeAreRefusedBeforeAnyArithmetic) {
@@ -133,10 +134,10 @@ TEST(CommandGate, StartTimesOutsideTheWireRangeAreRefusedBeforeAnyArithmetic) {
   for (const std::int64_t t : bad) {
     CommandSample c = command(WireCommandKind::start, seq++);
     c.issued_host_time_ns = t;
-    EXPECT_EQ(gate.judge(c, kSynced).reason, CommandReason::bad_time) << t;
+    EXPECT_EQ(gate.judge(c, kSynced, kNoEstops).reason, CommandReason::bad_time) << t;
     c = command(WireCommandKind::start, seq++);
     c.start_host_time_ns = t;
-    EXPECT_EQ(gate.judge(c, kSynced).reason, CommandReason::bad_time) << t;
+    EXPECT_EQ(gate.judge(c, kSynced, kNoEstops).reason, CommandReason::bad_time) << t;
   }
 }
 
@@ -146,38 +147,45 @@ TEST(CommandGate, RemembersAnswersOfManyWritersWithinItsBounds) {
   for (std::uint8_t w = 0; w < 40; ++w) {
     EXPECT_EQ(handle(gate, command(WireCommandKind::stop, 50, w)).verdict, GateVerdict::deliver);
   }
-  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 50, 39), kSynced).verdict, GateVerdict::repeat);
-  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 49, 39), kSynced).reason, CommandReason::out_of_order);
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 50, 39), kSynced, kNoEstops).verdict, GateVerdict::repeat);
+  EXPECT_EQ(gate.judge(command(WireCommandKind::stop, 49, 39), kSynced, kNoEstops).reason, CommandReason::out_of_order);
 }
 
 // Rule 7: a clear-fault from another writer, issued before an emergency stop it
 // had not seen, must not undo it; per-writer ordering cannot tell.
 TEST(CommandGate, AClearFaultThatHasNotSeenTheLatestEstopIsRefused) {
   CommandGate gate(0, kVersion, kMaxAge);
+  constexpr std::uint32_t kLife = 0x5eed0001;
   CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
-  clear.estops_seen = 2;
-  const GateDecision late = gate.judge(clear, kSynced, 3);  // a third estop, from writer 2, landed first
+  clear.estops_seen = {kLife, 2};
+  const GateDecision late = gate.judge(clear, kSynced, {kLife, 3});  // a third estop, from writer 2, landed first
   EXPECT_EQ(late.verdict, GateVerdict::refuse);
   EXPECT_EQ(late.reason, CommandReason::estop_unseen);
   gate.record(clear, late.reason);
-  EXPECT_EQ(gate.judge(clear, kSynced, 3).reason, CommandReason::estop_unseen) << "a retry gets the same answer";
+  EXPECT_EQ(gate.judge(clear, kSynced, {kLife, 3}).reason, CommandReason::estop_unseen) << "a retry: same answer";
   // The sender looks again and clears with the count it now sees.
   CommandSample again = command(WireCommandKind::clear_fault, 21, 1);
-  again.estops_seen = 3;
-  EXPECT_EQ(handle(gate, again).verdict, GateVerdict::refuse) << "the count judged is the end cap's: 0 here";
-  again.seq = 22;
-  EXPECT_EQ(gate.judge(again, kSynced, 3).verdict, GateVerdict::deliver);
-  // A count from before the end cap restarted (higher than its own) is not a match either.
-  EXPECT_EQ(gate.judge(again, kSynced, 1).reason, CommandReason::estop_unseen);
+  again.estops_seen = {kLife, 3};
+  EXPECT_EQ(gate.judge(again, kSynced, {kLife, 3}).verdict, GateVerdict::deliver);
+}
+
+TEST(CommandGate, AClearFaultThatSawAnEarlierLifeNeverMatches) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
+  clear.estops_seen = {0x5eed0001, 1};
+  // The end cap restarted and took one estop in its new life: the same count.
+  EXPECT_EQ(gate.judge(clear, kSynced, {0x5eed0003, 1}).reason, CommandReason::estop_unseen);
+  // A tool that never heard the end cap names no life: refused, estops taken or not.
+  clear.estops_seen = {};
+  EXPECT_EQ(gate.judge(clear, kSynced, {0x5eed0003, 0}).reason, CommandReason::estop_unseen);
 }
 
 TEST(CommandGate, OnlyAClearFaultIsJudgedByTheEstopsItHasSeen) {
   CommandGate gate(0, kVersion, kMaxAge);
   std::uint32_t seq = 30;
   for (const WireCommandKind kind : {WireCommandKind::start, WireCommandKind::stop, WireCommandKind::emergency_stop}) {
-    CommandSample c = command(kind, seq++);
-    c.estops_seen = 0;
-    EXPECT_EQ(gate.judge(c, kSynced, 7).verdict, GateVerdict::deliver) << static_cast<int>(kind);
+    const CommandSample c = command(kind, seq++);
+    EXPECT_EQ(gate.judge(c, kSynced, {0x5eed0001, 7}).verdict, GateVerdict::deliver) << static_cast<int>(kind);
   }
 }
 
