@@ -40,6 +40,23 @@ void check_report(const std::string& name, const ground::CommandReport& report) 
   if (!report.all_accepted()) throw CommandError(1, name + ": not every end cap accepted");
 }
 
+// A console exists but did not send the command. A stop or estop then goes out from
+// this tool; a clear-fault does not: this tool's fresh participant would name the
+// estop counts it hears now, which may include an estop the console saw land since
+// the operator asked, and undo it (docs/dds.md, clear-fault).
+bool speak_instead(const std::string& name, const CommandArgs& args, ground::CommandKind kind,
+                   const std::filesystem::path& socket, const std::string& why) {
+  if (!args.console.empty()) throw CommandError(1, name + ": the console did not send it: " + why);
+  if (kind == ground::CommandKind::clear_fault) {
+    throw CommandError(1, name + ": the console at " + socket.string() + " did not send it (" + why +
+                              "); not sent: look at the end caps (tensegrity status), then clear again (or "
+                              "--no-console)");
+  }
+  std::fprintf(stderr, "%s: the console at %s did not send it (%s); sending on this tool's own participant\n",
+               name.c_str(), socket.c_str(), why.c_str());
+  return false;
+}
+
 // True when a console ran the command (its report checked); false when none listens.
 bool through_console(const std::string& name, const CommandArgs& args, ground::CommandKind kind) {
   if (args.no_console) return false;
@@ -56,10 +73,7 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
   } catch (const ground::OperatorLinkError& e) {
     // A console named with --console must answer; a broken default one must not
     // keep a stop from going out: the tool then speaks itself.
-    if (!args.console.empty()) throw CommandError(1, name + ": " + e.what());
-    std::fprintf(stderr, "%s: the console at %s did not answer properly (%s); sending on this tool's own participant\n",
-                 name.c_str(), socket.c_str(), e.what());
-    return false;
+    return speak_instead(name, args, kind, socket, std::string("it did not answer properly: ") + e.what());
   }
   if (!reply) {
     if (!args.console.empty()) throw CommandError(1, name + ": no console listens at " + socket.string());
@@ -71,23 +85,11 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
   if (reply->error.empty() && (reported & request.endcap_mask) != request.endcap_mask) {
     reply->error = "its report leaves out end caps this command addresses";
   }
-  if (reply->error.empty() && reply->report.preempted && none_acked && kind == ground::CommandKind::clear_fault) {
-    // Sent again from here it would name the estops counted after one that took over,
-    // and undo it: the operator must see that estop first.
-    std::printf("%s", ground::format_command_report(reply->report).c_str());
-    throw CommandError(1, name +
-                              ": the console ended it before it went out (an emergency stop took over, or the "
-                              "console is stopping); not sent: look at the end caps (tensegrity status), then clear "
-                              "again");
-  }
   if (!reply->error.empty() || (reply->report.preempted && none_acked)) {
-    // Refused (busy, stopping) or ended before any end cap answered: the command may
-    // not have gone out, so on the default socket the tool sends it itself.
+    // Refused (busy, stopping) or ended before any end cap answered (an estop took
+    // over, or the console is stopping): the command may not have gone out.
     const std::string why = reply->error.empty() ? "it stopped before any end cap answered" : reply->error;
-    if (!args.console.empty()) throw CommandError(1, name + ": the console did not send it: " + why);
-    std::fprintf(stderr, "%s: the console at %s did not send it (%s); sending on this tool's own participant\n",
-                 name.c_str(), socket.c_str(), why.c_str());
-    return false;
+    return speak_instead(name, args, kind, socket, why);
   }
   if (reply->report.preempted) {
     std::fprintf(stderr, "%s: an emergency stop sent after it took over%s\n", name.c_str(),
@@ -100,7 +102,9 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
 }
 
 // A fresh secured tool needs up to ~6 s to authenticate with twelve end caps
-// (docs/security.md), one rejoin 4 s more: the defaults leave room for both.
+// (docs/security.md), one rejoin 4 s more: the defaults leave room for both. A
+// clear-fault waits up to 8 s to hear each end cap before it sends (again after a
+// rejoin): 30 s leaves room for one.
 void add_command(CLI::App& app, const std::string& name, const std::string& help, ground::CommandKind kind,
                  double default_timeout_s) {
   auto args = std::make_shared<CommandArgs>();
@@ -147,7 +151,7 @@ void add_clear_fault_command(CLI::App& app) {
               "Clear latched faults; end caps return to idle and must be started again. Waits (up to 8 s) to hear "
               "each end cap first; one that took an emergency stop this tool had not heard of refuses "
               "(estop_unseen): look again, then clear",
-              ground::CommandKind::clear_fault, 15.0);
+              ground::CommandKind::clear_fault, 30.0);
 }
 
 }  // namespace tensegrity::cli

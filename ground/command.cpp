@@ -142,9 +142,12 @@ CommandReport send_command_rejoining(std::unique_ptr<Station>& station, CommandK
     CommandOptions slice = options;
     slice.endcap_mask = missing;
     slice.estops_seen = seen;
-    // A clear-fault first waits to hear the end caps (send_command): the stall clock
-    // starts after that.
-    const double hear_s = kind == CommandKind::clear_fault ? kClearHearWaitS : 0.0;
+    // A clear-fault first waits to hear end caps it does not know yet, while its
+    // station is young (send_command): the stall clock starts after that.
+    const std::int64_t young_until = station->started_ns() + static_cast<std::int64_t>(kClearHearWaitS * 1e9);
+    const double hear_s = kind == CommandKind::clear_fault && !seen->all_known(missing)
+                              ? std::max(0.0, static_cast<double>(young_until - slice_start) / 1e9)
+                              : 0.0;
     slice.timeout_s = std::min(rejoin.stall_s + hear_s, static_cast<double>(deadline - slice_start) / 1e9);
     if (!(slice.timeout_s > 0.0)) return report;
     bool progress = false;

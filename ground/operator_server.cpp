@@ -77,6 +77,7 @@ CommandReport OperatorServer::run(const OperatorRequest& request) {
   if (request.kind == CommandKind::clear_fault) {
     seen = std::make_shared<EstopsSeen>(estops_seen_now(*station_(), request.endcap_mask));
   }
+  ++asked_;
   if (estop) ++estops_waiting_;
   std::unique_lock lock(command_mutex_);
   if (estop) --estops_waiting_;

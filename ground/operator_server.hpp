@@ -49,6 +49,7 @@ class OperatorServer {
   const std::filesystem::path& socket_path() const { return socket_path_; }
   std::uint64_t served() const { return served_.load(); }
   std::uint64_t refused() const { return refused_.load(); }
+  std::uint64_t asked() const { return asked_.load(); }  // commands taken, any source, done or not
 
  private:
   void accept_loop(const std::stop_token& stop);
@@ -64,6 +65,7 @@ class OperatorServer {
   std::uint16_t estop_handover_mask_ = 0;  // under command_mutex_
   std::atomic<std::uint64_t> served_{0};
   std::atomic<std::uint64_t> refused_{0};
+  std::atomic<std::uint64_t> asked_{0};
   std::mutex connections_mutex_;
   struct Connection {
     std::jthread thread;

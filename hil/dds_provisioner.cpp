@@ -241,9 +241,11 @@ bool DdsProvisioner::clear_faults_before_start(std::uint16_t mask, std::int64_t 
   for (int e = 0; e < ground::kEndcapCount; ++e) {
     const ground::EndcapStatus s = station_->snapshot()[e];
     if ((mask & (1U << e)) == 0 || !s.seen || s.heartbeat.fault() == 0) continue;
-    if (s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop)) {
-      // An operator's stop is theirs to clear, never the launcher's.
-      note("dds: end cap " + std::to_string(e) + " holds an emergency stop: not cleared by the launcher");
+    // An operator's stop is theirs to clear, never the launcher's (which sends none):
+    // any estop this life took, also one latched on top of a milder first fault.
+    if (s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop) || s.estops.count > 0) {
+      note("dds: end cap " + std::to_string(e) +
+           " took an emergency stop: left to the operator (tensegrity clear-fault)");
       return false;
     }
     faulted = static_cast<std::uint16_t>(faulted | (1U << e));
@@ -350,9 +352,13 @@ void DdsProvisioner::supervise() {
       // The clear names the estops this life took: wait for its own heartbeat.
       if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0 && s.heartbeat_host_ns > since) {
         // Latched while coming back (a sample late while the emulator served the
-        // others): the same clear-fault as before the run's start.
-        clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
-                                  ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s));
+        // others): the same clear-fault as before the run's start. Tried once: an
+        // end cap it does not clear (an operator's estop) is left as it is.
+        if (!clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
+                                       ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s))) {
+          std::lock_guard lock(mutex_);
+          if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
+        }
         continue;
       }
       const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&

@@ -12,8 +12,9 @@ namespace tensegrity::msgs {
 // ours. Bump on any change to an IDL file.
 // 2: time-sync request and reply carry a nonce.
 // 3: a host's heartbeat names the end caps it hears (heard_endcaps).
-// 4: a clear-fault names the emergency stops it has seen (lives_seen, estops_seen);
-//    heartbeats and command acks carry the end cap's (life_id, estops_received).
-inline constexpr std::uint16_t kFormatVersion = 4;
+// 4: a clear-fault names the emergency stops it has seen (estops_seen); heartbeats
+//    and command acks carry the end cap's count (estops_received).
+// 5: and the end cap's life (lives_seen; life_id).
+inline constexpr std::uint16_t kFormatVersion = 5;
 
 }  // namespace tensegrity::msgs

@@ -39,17 +39,21 @@ bool wait_estopped(const Station& station, std::uint16_t mask) {
   return all_estopped(station, mask);
 }
 
-// Another tool's estop, on its own participant.
-CommandReport estop_from_another_tool(int domain) {
+// Another tool, on its own participant, that hears end caps 0-2 (null if it does not).
+std::unique_ptr<Station> another_tool(int domain) {
   StationOptions o;
   o.domain = domain;
   o.name = "console_clear_other_tool";
-  Station other(o);
-  EXPECT_TRUE(other.wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000));
+  auto other = std::make_unique<Station>(o);
+  if (!other->wait_for_endcaps(0b111, false, Station::now_ns() + 20'000'000'000)) return nullptr;
+  return other;
+}
+
+CommandReport estop(Station& station) {
   CommandOptions co;
   co.endcap_mask = 0b111;
   co.retry_interval_s = kEstopRetryIntervalS;
-  return send_command(other, CommandKind::emergency_stop, 0, co);
+  return send_command(station, CommandKind::emergency_stop, 0, co);
 }
 
 // A stop for 0-3 holds the console (end cap 3 never answers); a clear-fault for 0-2
@@ -59,13 +63,16 @@ TEST_F(ConsoleLink, AClearQueuedBehindAStopDoesNotUndoAnEstopThatLandedMeanwhile
   constexpr int kDomain = 188;
   const std::shared_ptr<Station> station = three_endcaps(kDomain);
   ASSERT_TRUE(station) << "end caps 0-2 or the station did not come up";
+  const std::unique_ptr<Station> other = another_tool(kDomain);
+  ASSERT_TRUE(other) << "the other tool hears no end cap";
   OperatorServer server([station] { return station; }, dir_ / "c.sock");
-  auto stop = std::async(std::launch::async, [&] { return server.run({CommandKind::stop, 0b1111, 4.0}); });
+  auto stop = std::async(std::launch::async, [&] { return server.run({CommandKind::stop, 0b1111, 10.0}); });
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   auto clear = std::async(std::launch::async, [&] { return server.run({CommandKind::clear_fault, 0b111, 10.0}); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  const CommandReport estop = estop_from_another_tool(kDomain);
-  ASSERT_TRUE(estop.all_accepted()) << format_command_report(estop);
+  for (int i = 0; i < 2000 && server.asked() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(server.asked(), 2U) << "the clear never reached the console";
+  const CommandReport stopped = estop(*other);
+  ASSERT_TRUE(stopped.all_accepted()) << format_command_report(stopped);
   ASSERT_TRUE(wait_estopped(*station, 0b111));
   EXPECT_FALSE(stop.get().preempted) << "the stop ran to its deadline: the estop was not the console's";
   const CommandReport cleared = clear.get();
@@ -94,9 +101,14 @@ TEST_F(ConsoleLink, TheClearFaultToolDoesNotResendAClearAnEstopPreempted) {
   const std::string domain = std::to_string(kDomain);
   test::Subprocess tool({TENSEGRITY_CLI, "clear-fault", "--insecure", "--domain", domain, "--endcaps", "0-3"},
                         dir_ / "clear.out", dir_ / "clear.err");
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // connected; the console waits to hear end cap 3
-  const CommandReport estop = server.run({CommandKind::emergency_stop, 0b111, 5.0});
-  EXPECT_TRUE(estop.all_accepted()) << format_command_report(estop);
+  // The console has the clear (it waits to hear end cap 3) before the estop.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (server.asked() < 1 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(server.asked(), 1U) << "the tool never reached the console";
+  const CommandReport stopped = server.run({CommandKind::emergency_stop, 0b111, 5.0});
+  EXPECT_TRUE(stopped.all_accepted()) << format_command_report(stopped);
   EXPECT_EQ(tool.wait_exit(std::chrono::seconds(60)), 1);
   ::unsetenv("XDG_RUNTIME_DIR");
   std::ifstream err_file(dir_ / "clear.err");
