@@ -46,7 +46,6 @@ CommandReport unanswered(CommandKind kind, std::int64_t start_host_time_ns, std:
   }
   return report;
 }
-
 }  // namespace
 
 CommandReport send_command(Station& station, CommandKind kind, std::int64_t start_host_time_ns,

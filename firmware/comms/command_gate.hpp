@@ -18,9 +18,9 @@
 //    able to make them "stale".
 // 7. Clear-fault only: it names the emergency stops its sender had seen this end
 //    cap take (its life id and count); when the end cap has taken another since, or
-//    it is another life, the clear is refused (estop_unseen). Ordering (rule 5) is per writer, so without this a
-//    clear-fault from one tool, delayed on the link, could land after another
-//    tool's emergency stop and undo it.
+//    it is another life, the clear is refused (estop_unseen). Ordering (rule 5) is
+//    per writer, so without this a clear-fault from one tool, delayed on the link,
+//    could land after another tool's emergency stop and undo it.
 //
 // History: the end cap's command reader is VOLATILE, so a fresh end cap is never
 // handed the samples a writer kept from before it matched (msgs/qos_profiles.xml,
