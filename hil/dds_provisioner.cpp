@@ -27,16 +27,15 @@ namespace tensegrity::hil {
 namespace {
 
 constexpr std::int64_t kNsPerS = 1'000'000'000;
-constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
+
+}  // namespace
 
 // Threads of this provisioner talk DDS; they must not inherit the emulator's
 // SCHED_FIFO (they would compete with the stepper they wait for).
-void normal_priority() {
+void DdsProvisioner::normal_priority() {
   sched_param p{};
   pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
 }
-
-}  // namespace
 
 DdsProvisioner::DdsProvisioner(const sim::Robot& robot, const sim::Policy& policy,
                                const std::filesystem::path& policy_file, const DdsProvisionerConfig& config)
@@ -45,7 +44,8 @@ DdsProvisioner::DdsProvisioner(const sim::Robot& robot, const sim::Policy& polic
       policy_id_(policy_file.stem().string().substr(0, 64)),
       config_(config),
       lease_(config.domain),
-      restarted_at_ns_(static_cast<std::size_t>(robot.endcap_count()), 0) {
+      restarted_at_ns_(static_cast<std::size_t>(robot.endcap_count()), 0),
+      withheld_by_(static_cast<std::size_t>(robot.endcap_count()), -1) {
   if (robot.endcap_count() > ground::kEndcapCount) {
     throw HilError("the DDS link addresses at most " + std::to_string(ground::kEndcapCount) + " end caps");
   }
@@ -77,7 +77,7 @@ std::string DdsProvisioner::name() const {
          ", upload + start command)";
 }
 
-std::vector<std::string> DdsProvisioner::endcap_arguments(int, bool restart) const {
+std::vector<std::string> DdsProvisioner::endcap_arguments(int e, bool restart) const {
   std::vector<std::string> args{"--domain", std::to_string(lease_.domain()), "--dds-cut-signals", "--host-loss",
                                 config_.host_loss};
   if (config_.keystore.empty()) {
@@ -86,8 +86,14 @@ std::vector<std::string> DdsProvisioner::endcap_arguments(int, bool restart) con
     args.insert(args.end(), {"--keystore", config_.keystore.string()});
   }
   // Lockstep: the stepper's gate lets a restarted end cap through on a period
-  // boundary, and start on boot makes that tick table time 0 (see the header).
-  if (restart && config_.mode == StepperMode::lockstep) args.emplace_back("--start-on-boot");
+  // boundary, and start on boot makes that tick table time 0 (see the header);
+  // unless the operator stopped the run: then it comes up idle (on_restart says so).
+  if (restart && config_.mode == StepperMode::lockstep) {
+    const int stopped_by = operator_stop();
+    std::lock_guard lock(mutex_);
+    if (e < static_cast<int>(withheld_by_.size())) withheld_by_[e] = stopped_by;
+    if (stopped_by < 0) args.emplace_back("--start-on-boot");
+  }
   return args;
 }
 
@@ -288,107 +294,6 @@ double DdsProvisioner::settle_time_sync(std::uint16_t mask, std::int64_t deadlin
     }
     if (worst <= limit_ns || ground::Station::now_ns() >= deadline_ns) return static_cast<double>(worst) * 1e-9;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-}
-
-void DdsProvisioner::on_restart(int endcap) {
-  std::lock_guard lock(mutex_);
-  if (endcap >= 0 && endcap < static_cast<int>(restarted_at_ns_.size()))
-    restarted_at_ns_[endcap] = ground::Station::now_ns();
-}
-
-void DdsProvisioner::begin_run() {
-  // Lockstep rejoins need no host: start on boot + the stepper's gate.
-  if (config_.mode != StepperMode::realtime || supervisor_.joinable()) return;
-  stopping_ = false;
-  run_begun_ns_ = ground::Station::now_ns();
-  unheard_since_ns_.assign(restarted_at_ns_.size(), 0);
-  {
-    std::lock_guard lock(mutex_);
-    hearing_.assign(restarted_at_ns_.size(), HostHearing{});
-  }
-  supervisor_ = std::thread([this] {
-    normal_priority();
-    supervise();
-  });
-}
-
-void DdsProvisioner::end_run() {
-  stopping_ = true;
-  if (!supervisor_.joinable()) return;
-  supervisor_.join();
-  run_ended_ns_ = ground::Station::now_ns();
-}
-
-// Real time: a restarted end cap is idle with its stored table. Once it is back on
-// the link, synchronized and with its drives enabled, it gets the run's original
-// start time: it plays its table as far along as the others, in phase.
-void DdsProvisioner::supervise() {
-  while (!stopping_) {
-    std::this_thread::sleep_for(kSupervisePeriod);
-    const auto status = station_->snapshot();
-    watch_link(status, ground::Station::now_ns());
-    std::vector<std::pair<int, std::int64_t>> pending;
-    {
-      std::lock_guard lock(mutex_);
-      for (std::size_t e = 0; e < restarted_at_ns_.size(); ++e) {
-        if (restarted_at_ns_[e] != 0) pending.emplace_back(static_cast<int>(e), restarted_at_ns_[e]);
-      }
-    }
-    if (pending.empty()) continue;
-    for (const auto& [e, since] : pending) {
-      const ground::EndcapStatus& s = status[e];
-      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {
-        // The start command is durable (transient local): a program started again
-        // within command_max_age_s of it takes it from the link's history, and its
-        // start time is the run's. Nothing left to do.
-        std::lock_guard lock(mutex_);
-        if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
-        log_.push_back("dds: end cap " + std::to_string(e) +
-                       " back after a restart: playing again at the run's start time (the start command from the "
-                       "link's history)");
-        continue;
-      }
-      // The clear names the estops this life took: wait for its own heartbeat.
-      if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0 && s.heartbeat_host_ns > since) {
-        // Latched while coming back (a sample late while the emulator served the
-        // others): the same clear-fault as before the run's start. Tried once: an
-        // end cap it does not clear (an operator's estop) is left as it is.
-        if (!clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
-                                       ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s))) {
-          std::lock_guard lock(mutex_);
-          if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
-        }
-        continue;
-      }
-      const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
-                         s.telemetry_host_ns > since && s.telemetry.drives_enabled() && s.telemetry.mode() == 0 &&
-                         s.telemetry.fault() == 0;
-      if (!ready) continue;
-      // Its phase is as good as its clock: give the time sync a moment.
-      const double round_trip_s =
-          settle_time_sync(static_cast<std::uint16_t>(1U << e),
-                           ground::Station::now_ns() + core::seconds_to_ns(config_.rejoin_sync_settle_timeout_s));
-      ground::CommandOptions co;
-      co.endcap_mask = static_cast<std::uint16_t>(1U << e);
-      co.timeout_s = config_.command_timeout_s;
-      const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::start, start_host_ns_, co);
-      char line[300];
-      const double behind_s = static_cast<double>(ground::Station::now_ns() - start_host_ns_) * 1e-9;
-      if (r.all_accepted()) {
-        std::snprintf(line, sizeof line,
-                      "dds: end cap %d back after a restart: started at the run's start time (table %.3f s along; "
-                      "time-sync round trip %.3f ms)",
-                      e, behind_s, round_trip_s * 1e3);
-        std::lock_guard lock(mutex_);
-        if (restarted_at_ns_[e] == since) restarted_at_ns_[e] = 0;
-        log_.push_back(line);
-      } else {
-        std::snprintf(line, sizeof line, "dds: end cap %d back after a restart: start not accepted (%s); trying again",
-                      e, r.results.empty() ? "no answer" : r.results[0].text.c_str());
-        note(line);
-      }
-    }
   }
 }
 

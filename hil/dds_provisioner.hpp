@@ -13,6 +13,9 @@
 //  - real time: a supervisor thread waits for it to come back (heartbeat, clock
 //    synchronized, drives enabled, idle) and sends it the run's original start
 //    time; an end cap started "in the past" plays its table that far along.
+// Unless the operator stopped the run: once any end cap reports an emergency stop
+// (in its present life), a restarted end cap is left idle in both modes; starting
+// it again is the operator's (dds_provisioner_rejoin.cpp).
 #pragma once
 
 #include <array>
@@ -99,6 +102,14 @@ class DdsProvisioner final : public Provisioner {
   std::int64_t place_start(StartHandshake& handshake, std::string& how);
   void send_start(std::uint16_t mask, std::int64_t start_ns);
   void supervise();
+  // The supervisor's step for one restarted end cap (restarted at host time `since`).
+  void rejoin(int endcap, std::int64_t since, const ground::EndcapStatus& status);
+  // Forgets a pending restart (if still the one of `since`), with a line for the log.
+  void settle_restart(int endcap, std::int64_t since, const std::string& line);
+  // An end cap that took an emergency stop: the first one seen (latched for the
+  // run), -1 if none has. Any thread.
+  int operator_stop() const;
+  static void normal_priority();
   // The host's side of the link during a real-time run (dds_provisioner_link.cpp): an
   // end cap unheard for kUnheardAfterNs is logged, and again when it is heard, with how
   // long, so a lost or muted end cap is seen in the run's log. Supervisor thread only.
@@ -131,6 +142,9 @@ class DdsProvisioner final : public Provisioner {
   std::int64_t run_ended_ns_ = 0;               // ... at end_run
   std::vector<std::int64_t> unheard_since_ns_;  // per end cap: its last heartbeat while unheard (0: heard)
   std::vector<HostHearing> hearing_;            // per end cap, closed spells; under mutex_
+  // Lockstep, per end cap: the end cap whose estop kept its restart idle (-1: none).
+  mutable std::vector<int> withheld_by_;  // under mutex_
+  mutable std::atomic<int> operator_stop_{-1};
 };
 
 }  // namespace tensegrity::hil

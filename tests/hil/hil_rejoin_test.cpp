@@ -25,9 +25,8 @@ class HilRejoin : public ::testing::TestWithParam<RejoinCase> {};
 TEST_P(HilRejoin, KilledEndCapRestartsWithItsStoredPolicyAndRejoinsInPhase) {
   const RejoinCase c = GetParam();
   if (c.mode == StepperMode::realtime) TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
-  // Real time: killed late enough that the start command in the link's history is
-  // older than the end caps' replay limit (5 s): the provisioner itself has to
-  // start the new program, at the run's start time.
+  // Real time: the provisioner itself starts the new program at the run's start
+  // time (its command reader is volatile: it takes nothing from the link's history).
   const double kill_s = c.mode == StepperMode::lockstep ? 1.0 : 5.5;
   // Lockstep: no time passes while the new program starts, so it is back, and
   // through the gate, at the first period boundary after its bring-up (4 s), on any

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: Apache-2.0
+// DdsProvisioner during the run: a restarted end cap is brought back into the gait
+// (real time: the supervisor thread sends it the run's start time), unless the
+// operator stopped the run with an emergency stop. The end cap's new life knows
+// nothing of the stop its previous life took, so the launcher must not be the one
+// that sets it moving beside eleven stopped end caps.
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "firmware/core/fault.hpp"
+#include "ground/command.hpp"
+#include "hil/dds_provisioner.hpp"
+
+namespace tensegrity::hil {
+
+namespace {
+
+constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
+
+std::string left_idle(int endcap, int stopped_by) {
+  return "dds: end cap " + std::to_string(endcap) + " back after a restart: left idle (end cap " +
+         std::to_string(stopped_by) + " took an emergency stop; starting it again is the operator's: tensegrity start)";
+}
+
+}  // namespace
+
+int DdsProvisioner::operator_stop() const {
+  if (const int latched = operator_stop_.load(); latched >= 0) return latched;
+  const auto status = station_->snapshot();
+  for (int e = 0; e < robot_.endcap_count(); ++e) {
+    const ground::EndcapStatus& s = status[e];
+    if (!s.seen) continue;
+    if (s.estops.count > 0 || s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop)) {
+      int none = -1;
+      operator_stop_.compare_exchange_strong(none, e);
+      return operator_stop_.load();
+    }
+  }
+  return -1;
+}
+
+void DdsProvisioner::on_restart(int endcap) {
+  std::lock_guard lock(mutex_);
+  if (endcap < 0 || endcap >= static_cast<int>(restarted_at_ns_.size())) return;
+  if (config_.mode == StepperMode::lockstep) {
+    if (withheld_by_[endcap] >= 0) log_.push_back(left_idle(endcap, withheld_by_[endcap]));
+    return;
+  }
+  restarted_at_ns_[endcap] = ground::Station::now_ns();
+}
+
+void DdsProvisioner::begin_run() {
+  // Lockstep rejoins need no host: start on boot + the stepper's gate.
+  if (config_.mode != StepperMode::realtime || supervisor_.joinable()) return;
+  stopping_ = false;
+  run_begun_ns_ = ground::Station::now_ns();
+  unheard_since_ns_.assign(restarted_at_ns_.size(), 0);
+  {
+    std::lock_guard lock(mutex_);
+    hearing_.assign(restarted_at_ns_.size(), HostHearing{});
+  }
+  supervisor_ = std::thread([this] {
+    normal_priority();
+    supervise();
+  });
+}
+
+void DdsProvisioner::end_run() {
+  stopping_ = true;
+  if (!supervisor_.joinable()) return;
+  supervisor_.join();
+  run_ended_ns_ = ground::Station::now_ns();
+}
+
+void DdsProvisioner::settle_restart(int endcap, std::int64_t since, const std::string& line) {
+  std::lock_guard lock(mutex_);
+  if (restarted_at_ns_[endcap] == since) restarted_at_ns_[endcap] = 0;
+  if (!line.empty()) log_.push_back(line);
+}
+
+// Real time: a restarted end cap is idle with its stored table. Once it is back on
+// the link, synchronized and with its drives enabled, it gets the run's original
+// start time: it plays its table as far along as the others, in phase.
+void DdsProvisioner::supervise() {
+  while (!stopping_) {
+    std::this_thread::sleep_for(kSupervisePeriod);
+    const auto status = station_->snapshot();
+    watch_link(status, ground::Station::now_ns());
+    std::vector<std::pair<int, std::int64_t>> pending;
+    {
+      std::lock_guard lock(mutex_);
+      for (std::size_t e = 0; e < restarted_at_ns_.size(); ++e) {
+        if (restarted_at_ns_[e] != 0) pending.emplace_back(static_cast<int>(e), restarted_at_ns_[e]);
+      }
+    }
+    for (const auto& [e, since] : pending) rejoin(e, since, status[e]);
+  }
+}
+
+void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatus& s) {
+  // Checked at every step: an estop may land while the end cap is coming back.
+  if (const int stopped_by = operator_stop(); stopped_by >= 0) {
+    settle_restart(e, since, left_idle(e, stopped_by));
+    return;
+  }
+  if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {
+    // Its commands reader is volatile, so only a start sent after it came back
+    // (an operator's `tensegrity start`) can have set it playing. Nothing left to do.
+    settle_restart(e, since, "dds: end cap " + std::to_string(e) + " back after a restart: already playing");
+    return;
+  }
+  // The clear names the estops this life took: wait for its own heartbeat.
+  if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.fault() != 0 && s.heartbeat_host_ns > since) {
+    // Latched while coming back (a sample late while the emulator served the
+    // others): the same clear-fault as before the run's start. Tried once: an
+    // end cap it does not clear (an operator's estop) is left as it is.
+    if (!clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
+                                   ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s))) {
+      settle_restart(e, since, "");
+    }
+    return;
+  }
+  const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
+                     s.telemetry_host_ns > since && s.telemetry.drives_enabled() && s.telemetry.mode() == 0 &&
+                     s.telemetry.fault() == 0;
+  if (!ready) return;
+  // Its phase is as good as its clock: give the time sync a moment.
+  const double round_trip_s =
+      settle_time_sync(static_cast<std::uint16_t>(1U << e),
+                       ground::Station::now_ns() + core::seconds_to_ns(config_.rejoin_sync_settle_timeout_s));
+  // The last look before it moves: an estop in the settling time still wins.
+  if (const int stopped_by = operator_stop(); stopped_by >= 0) {
+    settle_restart(e, since, left_idle(e, stopped_by));
+    return;
+  }
+  ground::CommandOptions co;
+  co.endcap_mask = static_cast<std::uint16_t>(1U << e);
+  co.timeout_s = config_.command_timeout_s;
+  const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::start, start_host_ns_, co);
+  char line[300];
+  const double behind_s = static_cast<double>(ground::Station::now_ns() - start_host_ns_) * 1e-9;
+  if (r.all_accepted()) {
+    std::snprintf(line, sizeof line,
+                  "dds: end cap %d back after a restart: started at the run's start time (table %.3f s along; "
+                  "time-sync round trip %.3f ms)",
+                  e, behind_s, round_trip_s * 1e3);
+    settle_restart(e, since, line);
+  } else {
+    std::snprintf(line, sizeof line, "dds: end cap %d back after a restart: start not accepted (%s); trying again", e,
+                  r.results.empty() ? "no answer" : r.results[0].text.c_str());
+    note(line);
+  }
+}
+
+}  // namespace tensegrity::hil
