@@ -9,6 +9,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -30,8 +31,23 @@ namespace dds = eprosima::fastdds::dds;
 namespace {
 bool valid_endcap(int id) { return id >= 0 && id < kEndcapCount; }
 
-void merge_estops(fw::comms::EstopCount& known, const fw::comms::EstopCount& heard) {
-  if (heard.life_id != known.life_id || heard.count > known.count) known = heard;
+// False, and nothing kept, for a report of a life the end cap has left.
+bool merge_estops(EndcapStatus& e, const fw::comms::EstopCount& heard) {
+  const auto& left = e.left_lives;
+  if (heard.life_id != 0 && std::find(left.begin(), left.end(), heard.life_id) != left.end()) {
+    ++e.stale_life_samples;
+    return false;
+  }
+  if (heard.life_id != e.estops.life_id) {
+    if (e.estops.life_id != 0) {
+      std::copy_backward(e.left_lives.begin(), e.left_lives.end() - 1, e.left_lives.end());
+      e.left_lives[0] = e.estops.life_id;
+    }
+    e.estops = heard;
+  } else if (heard.count > e.estops.count) {
+    e.estops.count = heard.count;
+  }
+  return true;
 }
 }  // namespace
 
@@ -322,7 +338,7 @@ void StationListeners::telemetry(Station& s, dds::DataReader* r) {
 void Station::note_estops(int endcap, const fw::comms::EstopCount& heard) {
   if (endcap < 0 || endcap >= kEndcapCount) return;
   std::lock_guard lock(mutex_);
-  merge_estops(status_[static_cast<std::size_t>(endcap)].estops, heard);
+  merge_estops(status_[static_cast<std::size_t>(endcap)], heard);
 }
 
 void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
@@ -339,9 +355,9 @@ void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
       }
       continue;
     }
+    if (!merge_estops(e, {hb.life_id(), hb.estops_received()})) continue;
     e.seen = true;
     e.heartbeat = hb;
-    merge_estops(e.estops, {hb.life_id(), hb.estops_received()});
     e.heartbeat_host_ns = Station::now_ns();
     s.changed_.notify_all();
   }

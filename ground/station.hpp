@@ -62,6 +62,12 @@ struct EndcapStatus {
   // life the highest count wins (a heartbeat read before an estop may arrive after
   // its ack); a new life replaces it.
   fw::comms::EstopCount estops;
+  // Lives this end cap has left, latest first (0: none). A program draws its life
+  // when it starts, so a life never comes back: a heartbeat or ack of one that
+  // arrives late is stale and is dropped (it would show the dead program's fault
+  // and count until the next heartbeat).
+  std::array<std::uint32_t, 4> left_lives{};
+  std::uint64_t stale_life_samples = 0;
 };
 
 class Station {

@@ -100,7 +100,9 @@ TEST_P(HilEstop, AnEndcapRestartedAfterAnOperatorsEstopStaysIdle) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, HilEstop, ::testing::Values(StepperMode::lockstep, StepperMode::realtime),
-                         [](const ::testing::TestParamInfo<StepperMode>& i) { return std::string(to_string(i.param)); });
+                         [](const ::testing::TestParamInfo<StepperMode>& i) {
+                           return std::string(to_string(i.param));
+                         });
 
 }  // namespace
 }  // namespace tensegrity::hil
