@@ -13,9 +13,10 @@
 //  - real time: a supervisor thread waits for it to come back (heartbeat, clock
 //    synchronized, drives enabled, idle) and sends it the run's original start
 //    time; an end cap started "in the past" plays its table that far along.
-// Unless the operator stopped the run: once any end cap reports an emergency stop
-// (in its present life), a restarted end cap is left idle in both modes; starting
-// it again is the operator's (dds_provisioner_rejoin.cpp).
+// Unless the operator stopped the run: once the launcher has heard any end cap take
+// an emergency stop during the run, every later restart is left idle in both modes,
+// for the rest of the run; starting it again is the operator's
+// (dds_provisioner_rejoin.cpp, docs/hil.md).
 #pragma once
 
 #include <array>
@@ -107,8 +108,10 @@ class DdsProvisioner final : public Provisioner {
   // Forgets a pending restart (if still the one of `since`), with a line for the log.
   void settle_restart(int endcap, std::int64_t since, const std::string& line);
   // An end cap that took an emergency stop: the first one seen (latched for the
-  // run), -1 if none has. Any thread.
+  // run: never undone, not by a clear-fault nor an operator's start, see the
+  // header), -1 if none has. Any thread.
   int operator_stop() const;
+  int operator_stop(const std::array<ground::EndcapStatus, ground::kEndcapCount>& status) const;
   static void normal_priority();
   // The host's side of the link during a real-time run (dds_provisioner_link.cpp): an
   // end cap unheard for kUnheardAfterNs is logged, and again when it is heard, with how
@@ -143,6 +146,9 @@ class DdsProvisioner final : public Provisioner {
   std::vector<std::int64_t> unheard_since_ns_;  // per end cap: its last heartbeat while unheard (0: heard)
   std::vector<HostHearing> hearing_;            // per end cap, closed spells; under mutex_
   // Lockstep, per end cap: the end cap whose estop kept its restart idle (-1: none).
+  // Written by endcap_arguments (const for the launcher, but it decides here whether
+  // the program gets --start-on-boot), read by on_restart, which the launcher calls
+  // right after; both on the stepper's thread.
   mutable std::vector<int> withheld_by_;  // under mutex_
   mutable std::atomic<int> operator_stop_{-1};
 };

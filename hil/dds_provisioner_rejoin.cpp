@@ -4,6 +4,7 @@
 // operator stopped the run with an emergency stop. The end cap's new life knows
 // nothing of the stop its previous life took, so the launcher must not be the one
 // that sets it moving beside eleven stopped end caps.
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -27,13 +28,18 @@ std::string left_idle(int endcap, int stopped_by) {
 
 }  // namespace
 
-int DdsProvisioner::operator_stop() const {
+int DdsProvisioner::operator_stop() const { return operator_stop(station_->snapshot()); }
+
+// Heartbeats (5 Hz) carry the estop count; telemetry (100 Hz) shows the latched
+// fault sooner, which matters to lockstep's one look when it spawns the program.
+int DdsProvisioner::operator_stop(const std::array<ground::EndcapStatus, ground::kEndcapCount>& status) const {
   if (const int latched = operator_stop_.load(); latched >= 0) return latched;
-  const auto status = station_->snapshot();
+  constexpr auto kEstop = static_cast<std::uint8_t>(core::FaultCause::emergency_stop);
   for (int e = 0; e < robot_.endcap_count(); ++e) {
     const ground::EndcapStatus& s = status[e];
-    if (!s.seen) continue;
-    if (s.estops.count > 0 || s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop)) {
+    const bool estopped = (s.seen && (s.estops.count > 0 || s.heartbeat.fault() == kEstop)) ||
+                          (s.have_telemetry && s.telemetry.fault() == kEstop);
+    if (estopped) {
       int none = -1;
       operator_stop_.compare_exchange_strong(none, e);
       return operator_stop_.load();
@@ -89,6 +95,7 @@ void DdsProvisioner::supervise() {
     std::this_thread::sleep_for(kSupervisePeriod);
     const auto status = station_->snapshot();
     watch_link(status, ground::Station::now_ns());
+    operator_stop(status);  // latched when it happens, restart or not
     std::vector<std::pair<int, std::int64_t>> pending;
     {
       std::lock_guard lock(mutex_);
@@ -101,15 +108,15 @@ void DdsProvisioner::supervise() {
 }
 
 void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatus& s) {
-  // Checked at every step: an estop may land while the end cap is coming back.
-  if (const int stopped_by = operator_stop(); stopped_by >= 0) {
-    settle_restart(e, since, left_idle(e, stopped_by));
-    return;
-  }
   if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {
     // Its commands reader is volatile, so only a start sent after it came back
     // (an operator's `tensegrity start`) can have set it playing. Nothing left to do.
     settle_restart(e, since, "dds: end cap " + std::to_string(e) + " back after a restart: already playing");
+    return;
+  }
+  // Checked at every step: an estop may land while the end cap is coming back.
+  if (const int stopped_by = operator_stop(); stopped_by >= 0) {
+    settle_restart(e, since, left_idle(e, stopped_by));
     return;
   }
   // The clear names the estops this life took: wait for its own heartbeat.
