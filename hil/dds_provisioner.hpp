@@ -15,8 +15,9 @@
 //    time; an end cap started "in the past" plays its table that far along.
 // Unless the operator stopped the run: once the launcher has heard any end cap take
 // an emergency stop during the run, every later restart is left idle in both modes,
-// for the rest of the run; starting it again is the operator's
-// (dds_provisioner_rejoin.cpp, docs/hil.md).
+// for the rest of the run; starting it again is the operator's. Lockstep decides at
+// the spawn, so an end cap started on boot is stopped by the launcher if the estop
+// is heard just after (dds_provisioner_rejoin.cpp, docs/hil.md).
 #pragma once
 
 #include <array>
@@ -105,6 +106,8 @@ class DdsProvisioner final : public Provisioner {
   void supervise();
   // The supervisor's step for one restarted end cap (restarted at host time `since`).
   void rejoin(int endcap, std::int64_t since, const ground::EndcapStatus& status);
+  // Lockstep's: stops an end cap started on boot if an estop is heard just after.
+  void recall(int endcap, std::int64_t since, const ground::EndcapStatus& status);
   // Forgets a pending restart (if still the one of `since`), with a line for the log.
   void settle_restart(int endcap, std::int64_t since, const std::string& line);
   // An end cap that took an emergency stop: the first one seen (latched for the
@@ -137,8 +140,10 @@ class DdsProvisioner final : public Provisioner {
 
   mutable std::mutex mutex_;
   std::vector<std::string> log_;
-  LinkTiming timing_;                          // under mutex_
-  std::vector<std::int64_t> restarted_at_ns_;  // per end cap: host time of a restart not yet started (0: none)
+  LinkTiming timing_;  // under mutex_
+  // Per end cap: host time of a restart the supervisor still watches (0: none); real
+  // time: not yet started; lockstep: started on boot, in its recall window.
+  std::vector<std::int64_t> restarted_at_ns_;
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
   std::int64_t run_begun_ns_ = 0;               // host clock at begin_run (the supervisor's start)

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // DdsProvisioner during the run: a restarted end cap is brought back into the gait
-// (real time: the supervisor thread sends it the run's start time), unless the
-// operator stopped the run with an emergency stop. The end cap's new life knows
-// nothing of the stop its previous life took, so the launcher must not be the one
-// that sets it moving beside eleven stopped end caps.
+// (real time: the supervisor thread sends it the run's start time; lockstep: its
+// program starts on boot), unless the operator stopped the run with an emergency
+// stop. The end cap's new life knows nothing of the stop its previous life took, so
+// the launcher must not be the one that sets it moving beside eleven stopped end caps.
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -20,6 +20,11 @@ namespace tensegrity::hil {
 namespace {
 
 constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
+// Lockstep: how long after its spawn an end cap started on boot is still the
+// launcher's to stop. An estop that reached the others before the spawn is heard
+// within one heartbeat period (0.2 s) of it; one after the spawn reaches the new
+// program through the operator's tool once the program is on the link.
+constexpr std::int64_t kRecallWindowNs = 500'000'000;
 
 std::string left_idle(int endcap, int stopped_by) {
   return "dds: end cap " + std::to_string(endcap) + " back after a restart: left idle (end cap " +
@@ -51,16 +56,18 @@ int DdsProvisioner::operator_stop(const std::array<ground::EndcapStatus, ground:
 void DdsProvisioner::on_restart(int endcap) {
   std::lock_guard lock(mutex_);
   if (endcap < 0 || endcap >= static_cast<int>(restarted_at_ns_.size())) return;
-  if (config_.mode == StepperMode::lockstep) {
-    if (withheld_by_[endcap] >= 0) log_.push_back(left_idle(endcap, withheld_by_[endcap]));
+  if (config_.mode == StepperMode::lockstep && withheld_by_[endcap] >= 0) {
+    log_.push_back(left_idle(endcap, withheld_by_[endcap]));
     return;
   }
+  // Real time: to be started; lockstep: started on boot, watched by recall().
   restarted_at_ns_[endcap] = ground::Station::now_ns();
 }
 
 void DdsProvisioner::begin_run() {
-  // Lockstep rejoins need no host: start on boot + the stepper's gate.
-  if (config_.mode != StepperMode::realtime || supervisor_.joinable()) return;
+  // Lockstep rejoins need no host (start on boot + the stepper's gate), but an
+  // estop heard just after the spawn must still stop them: recall().
+  if (supervisor_.joinable()) return;
   stopping_ = false;
   run_begun_ns_ = ground::Station::now_ns();
   unheard_since_ns_.assign(restarted_at_ns_.size(), 0);
@@ -94,7 +101,7 @@ void DdsProvisioner::supervise() {
   while (!stopping_) {
     std::this_thread::sleep_for(kSupervisePeriod);
     const auto status = station_->snapshot();
-    watch_link(status, ground::Station::now_ns());
+    if (config_.mode == StepperMode::realtime) watch_link(status, ground::Station::now_ns());
     operator_stop(status);  // latched when it happens, restart or not
     std::vector<std::pair<int, std::int64_t>> pending;
     {
@@ -103,7 +110,40 @@ void DdsProvisioner::supervise() {
         if (restarted_at_ns_[e] != 0) pending.emplace_back(static_cast<int>(e), restarted_at_ns_[e]);
       }
     }
-    for (const auto& [e, since] : pending) rejoin(e, since, status[e]);
+    for (const auto& [e, since] : pending) {
+      if (config_.mode == StepperMode::realtime) {
+        rejoin(e, since, status[e]);
+      } else {
+        recall(e, since, status[e]);
+      }
+    }
+  }
+}
+
+// Lockstep decided at the spawn that the program starts on boot. An estop the
+// launcher hears within kRecallWindowNs of that may have reached the others before
+// the spawn, and the operator's tool may be done before the new program is on the
+// link: the launcher stops it (idle, as if it had been left idle), re-sending until
+// it acks. After the window it is the operator's, as any playing end cap is.
+void DdsProvisioner::recall(int e, std::int64_t since, const ground::EndcapStatus& s) {
+  const int stopped_by = operator_stop();
+  if (stopped_by < 0) {
+    const bool heard = s.seen && s.heartbeat_host_ns > since;
+    if (heard && ground::Station::now_ns() - since > kRecallWindowNs) settle_restart(e, since, "");
+    return;
+  }
+  ground::CommandOptions co;
+  co.endcap_mask = static_cast<std::uint16_t>(1U << e);
+  co.timeout_s = config_.command_timeout_s;
+  const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::stop, 0, co);
+  if (r.all_accepted()) {
+    settle_restart(e, since,
+                   "dds: end cap " + std::to_string(e) +
+                       " back after a restart: stopped (it started on boot as end cap " + std::to_string(stopped_by) +
+                       " took an emergency stop; starting it again is the operator's: tensegrity start)");
+  } else {
+    note("dds: end cap " + std::to_string(e) + " back after a restart: stop not accepted (" +
+         (r.results.empty() ? std::string("no answer") : r.results[0].text) + "); trying again");
   }
 }
 

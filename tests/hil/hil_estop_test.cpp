@@ -3,11 +3,13 @@
 // killed and started again afterwards comes up idle, in both modes, instead of
 // being set moving by the launcher beside eleven stopped end caps (its new life
 // knows nothing of the stop its previous one took). The estop lands before the kill,
-// or while the killed program is being started again.
+// while the killed program is being started again, or just after it was spawned
+// (lockstep started it on boot: the launcher stops it).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <ostream>
@@ -26,28 +28,37 @@ using namespace hil_test;
 
 constexpr int kDomain = 204;  // unique per DDS test: ctest runs tests in parallel
 
-enum class When { before_kill, while_restarting };
+enum class When { before_kill, while_restarting, after_restart };
+
+const char* to_string(When w) {
+  switch (w) {
+    case When::before_kill: return "before_kill";
+    case When::while_restarting: return "while_restarting";
+    case When::after_restart: return "after_restart";
+  }
+  return "?";
+}
 
 struct EstopCase {
   StepperMode mode;
   When when;
 };
 
-void PrintTo(const EstopCase& c, std::ostream* os) {
-  *os << to_string(c.mode) << (c.when == When::before_kill ? ", estop before the kill" : ", estop while restarting");
-}
+void PrintTo(const EstopCase& c, std::ostream* os) { *os << to_string(c.mode) << ", estop " << to_string(c.when); }
 
-// The operator: one `tensegrity estop` to all twelve, once `go()` says so. Its tool
-// re-sends it until every end cap acks, so an end cap restarting meanwhile gets it
-// once its new program is on the link.
+// The operator: one `tensegrity estop` to the end caps of `mask`, once `go()` says
+// so. Its tool re-sends it until every one acks, so an end cap restarting meanwhile
+// gets it once its new program is on the link.
 class Operator {
  public:
-  explicit Operator(std::function<bool(const ground::Station&)> go) : go_(std::move(go)), thread_([this] { run(); }) {}
+  Operator(std::function<bool(const ground::Station&)> go, std::uint16_t mask)
+      : go_(std::move(go)), mask_(mask), thread_([this] { run(); }) {}
   ~Operator() {
     stop_ = true;
     thread_.join();
   }
   bool estop_accepted() const { return accepted_; }
+  std::int64_t accepted_ns() const { return accepted_ns_; }
 
  private:
   void run() {
@@ -60,9 +71,10 @@ class Operator {
     while (!stop_) {
       if (go_(station)) {
         ground::CommandOptions co;
-        co.endcap_mask = static_cast<std::uint16_t>((1U << 12) - 1U);
+        co.endcap_mask = mask_;
         co.timeout_s = 20.0;
         accepted_ = ground::send_command(station, ground::CommandKind::emergency_stop, 0, co).all_accepted();
+        accepted_ns_ = ground::Station::now_ns();
         return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -70,8 +82,10 @@ class Operator {
   }
 
   std::function<bool(const ground::Station&)> go_;
+  std::uint16_t mask_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> accepted_{false};
+  std::atomic<std::int64_t> accepted_ns_{0};
   std::thread thread_;
 };
 
@@ -86,52 +100,75 @@ class HilEstop : public ::testing::TestWithParam<EstopCase> {};
 TEST_P(HilEstop, AnEndcapRestartedAfterAnOperatorsEstopStaysIdle) {
   const EstopCase c = GetParam();
   if (c.mode == StepperMode::realtime) TENSEGRITY_SKIP_REAL_TIME_UNDER_ASAN();
-  const bool before = c.when == When::before_kill;
   // While restarting: time for the new program to join the link and ack the estop.
-  HilOptions o = options(before ? 14.0 : 20.0, Provision::dds);
+  HilOptions o = options(c.when == When::while_restarting ? 20.0 : 14.0, Provision::dds);
   o.mode = c.mode;
   o.dds_domain = kDomain;
   o.max_speed = 1.0;  // lockstep at the wall clock's pace, as an operator lives
   o.scenario.events = kill_and_restart(4, 8.0, 8.5);
   std::atomic<bool> killed{false};
+  std::atomic<std::int64_t> restarted_ns{0};
   HilResult r;
   bool accepted = false;
   bool estop_after_kill = false;
+  double estop_after_restart_s = 0.0;
   {
     // Before the kill: the operator hears all twelve playing within about a second of
     // the start. While restarting: between the kill (8 s) and the restart (8.5 s).
-    Operator op(before ? std::function<bool(const ground::Station&)>(all_playing)
-                       : [&killed](const ground::Station&) { return killed.load(); });
+    // After the restart: just after the spawn, to the eleven others only, standing
+    // in for a tool that was done before the new program was on the link.
+    std::function<bool(const ground::Station&)> go = all_playing;
+    std::uint16_t mask = (1U << 12) - 1U;
+    if (c.when == When::while_restarting) go = [&killed](const ground::Station&) { return killed.load(); };
+    if (c.when == When::after_restart) {
+      go = [&restarted_ns](const ground::Station&) { return restarted_ns.load() != 0; };
+      mask &= static_cast<std::uint16_t>(~(1U << 4));
+    }
+    Operator op(go, mask);
     o.after_step = [&](const WorldStepper& s, ProcessLauncher&) {
       const double t = s.stats().sim_time_s();
       if (t >= 8.05) killed = true;
+      if (t >= 8.51 && restarted_ns == 0) restarted_ns = ground::Station::now_ns();
       // Needed before the kill in that case: if a loaded host made it late, say so
       // instead of failing on what follows from it.
-      if (before && t >= 8.0 && !op.estop_accepted()) estop_after_kill = true;
+      if (c.when == When::before_kill && t >= 8.0 && !op.estop_accepted()) estop_after_kill = true;
     };
     r = run_hil(o);
     accepted = op.estop_accepted();
+    if (c.when == When::after_restart)
+      estop_after_restart_s = static_cast<double>(op.accepted_ns() - restarted_ns) * 1e-9;
   }
   ASSERT_TRUE(r.ok) << r.error;
-  ASSERT_TRUE(accepted) << "the operator's estop was not taken by all twelve";
+  ASSERT_TRUE(accepted) << "the operator's estop was not taken by all it was sent to";
   ASSERT_FALSE(estop_after_kill) << "the operator's estop was acked only after the kill at 8 s (a slow host?)";
+  // Lockstep stops an end cap started on boot only in its recall window (0.5 s).
+  if (c.mode == StepperMode::lockstep) {
+    ASSERT_LT(estop_after_restart_s, 0.3) << "the operator's estop was acked long after the restart (a slow host?)";
+  }
   EXPECT_EQ(r.endcaps.at(4).restarts, 1u);
   bool idle = false;
+  bool stopped = false;
   for (const auto& line : r.log) {
     EXPECT_EQ(line.find("end cap 4 back after a restart: started"), std::string::npos) << line;
     idle = idle || line.find("end cap 4 back after a restart: left idle") != std::string::npos;
+    stopped = stopped || line.find("end cap 4 back after a restart: stopped") != std::string::npos;
   }
-  // Lockstep while restarting decides at the spawn, 0.45 s after the estop: the
-  // launcher has heard it by then on any sane host, but the new program's own
-  // estop is what keeps it still if not (docs/hil.md, "Left open").
-  if (before || c.mode == StepperMode::realtime) {
+  // Lockstep decides at the spawn: an estop it hears after it (after_restart; while
+  // restarting only if the launcher had not heard it 0.45 s after it went out) is
+  // answered by a stop. Real time decides before it sends the start: idle.
+  if (c.mode == StepperMode::realtime || c.when == When::before_kill) {
     EXPECT_TRUE(idle) << ::testing::PrintToString(r.log);
+  } else if (c.when == When::after_restart) {
+    EXPECT_TRUE(stopped) << ::testing::PrintToString(r.log);
+  } else {
+    EXPECT_TRUE(idle || stopped) << ::testing::PrintToString(r.log);
   }
   EXPECT_EQ(r.playing, 0) << ::testing::PrintToString(r.log);
   for (const auto& e : r.endcaps) EXPECT_FALSE(e.playing) << "end cap " << e.endcap << " moves after the estop";
-  // Before the kill the new program never heard of the estop: idle, not stopped.
-  // While restarting the operator's tool re-sent it until the new program acked it.
-  EXPECT_EQ(r.endcaps.at(4).fault, before ? "none" : "emergency stop");
+  // The new program never heard of the estop before the kill or after the restart:
+  // idle, not stopped. While restarting the operator's tool re-sent it until the new
+  // program acked it.
+  EXPECT_EQ(r.endcaps.at(4).fault, c.when == When::while_restarting ? "emergency stop" : "none");
   EXPECT_EQ(r.endcaps.at(3).fault, "emergency stop");
   EXPECT_TRUE(child_pids().empty());
 }
@@ -140,10 +177,11 @@ INSTANTIATE_TEST_SUITE_P(Modes, HilEstop,
                          ::testing::Values(EstopCase{StepperMode::lockstep, When::before_kill},
                                            EstopCase{StepperMode::realtime, When::before_kill},
                                            EstopCase{StepperMode::lockstep, When::while_restarting},
-                                           EstopCase{StepperMode::realtime, When::while_restarting}),
+                                           EstopCase{StepperMode::realtime, When::while_restarting},
+                                           EstopCase{StepperMode::lockstep, When::after_restart},
+                                           EstopCase{StepperMode::realtime, When::after_restart}),
                          [](const ::testing::TestParamInfo<EstopCase>& i) {
-                           return std::string(to_string(i.param.mode)) +
-                                  (i.param.when == When::before_kill ? "_before_kill" : "_while_restarting");
+                           return std::string(to_string(i.param.mode)) + "_" + to_string(i.param.when);
                          });
 
 }  // namespace
