@@ -2,6 +2,7 @@
 #include "ground/command.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <stdexcept>
 
@@ -56,10 +57,12 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
   if (!(options.timeout_s > 0.0) || !(options.retry_interval_s > 0.0)) {
     throw std::invalid_argument("command: timeout and retry interval must be > 0 s");
   }
-  static std::uint32_t next_seq = random_sequence_base();
+  // Atomic: a HIL run's supervisor thread and an operator's in the same process
+  // (the tests) send commands at once; two equal seqs would share their acks.
+  static std::atomic<std::uint32_t> next_seq{random_sequence_base()};
   msg::Command_ cmd;
   cmd.format_version(msgs::kFormatVersion);
-  cmd.seq(next_seq++);
+  cmd.seq(next_seq.fetch_add(1));
   cmd.kind(static_cast<std::uint8_t>(kind));
   cmd.endcap_mask(options.endcap_mask);
   cmd.start_host_time_ns(start_host_time_ns);
