@@ -19,6 +19,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "firmware/app/config.hpp"
@@ -47,7 +48,12 @@ ProcessLauncher::ProcessLauncher(const LauncherConfig& config, Provisioner& prov
   std::string templ = (fs::temp_directory_path() / "tensegrity-hil-XXXXXX").string();
   if (::mkdtemp(templ.data()) == nullptr) throw HilError(std::string("mkdtemp: ") + std::strerror(errno));
   dir_ = templ;
-  const std::vector<std::uint16_t> ports = free_udp_ports(config_.endcap_count);
+  std::vector<std::uint16_t> ports;
+  try {
+    ports = free_udp_ports(config_.endcap_count);
+  } catch (const std::runtime_error& e) {
+    throw HilError(e.what());
+  }
   for (int e = 0; e < config_.endcap_count; ++e) {
     Slot& s = slots_[e];
     s.port = ports[e];

@@ -19,6 +19,7 @@
 #include "firmware/app/endcap_stats.hpp"
 #include "firmware/core/limits.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
+#include "hil/devices/udp_ports.hpp"
 #include "hil/provisioner.hpp"
 #include "hil/world_stepper.hpp"
 
@@ -118,10 +119,6 @@ inline constexpr double kRealtimeConsumerHeartbeatS = 0.2;
 // drive positions, load-cell samples; 20-100 ms by default, kept in lockstep).
 inline constexpr double kRealtimeSilenceTimeoutS = 0.2;
 
-// Free UDP ports on 127.0.0.1 for the end caps' buses, from the kLauncherPortSpan
-// ports just below the kernel's ephemeral range (bound together, then released).
-inline constexpr int kLauncherPortSpan = 2048;
-std::vector<std::uint16_t> free_udp_ports(int count);
 // The `endcap` program: $TENSEGRITY_ENDCAP, else the one built with this tree.
 std::filesystem::path default_endcap_binary();
 

@@ -19,7 +19,7 @@
 
 #include "firmware/app/policy_store.hpp"
 #include "ground/upload.hpp"
-#include "firmware/hal/udp_can_bus.hpp"
+#include "hil/devices/udp_ports.hpp"
 #include "sim/policy.hpp"
 #include "sim/robot.hpp"
 #include "tests/ground/subprocess.hpp"
@@ -35,11 +35,9 @@ constexpr int kDomain = 158;
 constexpr int kTrials = 100;
 constexpr int kEndcap = 0;
 
-std::uint16_t free_udp_port() {
-  std::string error;
-  auto probe = fw::UdpCanBus::open({{"127.0.0.1", 9}, {"127.0.0.1", 0}}, error);
-  return probe ? probe->local_port() : 0;  // closed again here; the race is harmless on loopback
-}
+// Below the ephemeral range: a port bound to 0 and released for the end cap could
+// go to any other socket binding 0 (a DDS participant of a test beside) first.
+std::uint16_t free_udp_port() { return hil::free_udp_ports(1).at(0); }
 
 TEST(PersistenceKill, RebootsWithTheOldOrTheNewTableEachUnderItsOwnIdentity) {
   const fs::path dir = fs::temp_directory_path() / ("persistence_kill_" + std::to_string(::getpid()));

@@ -23,6 +23,7 @@
 #include "firmware/drivers/spool_geometry.hpp"
 #include "firmware/hal/crc32.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
+#include "hil/devices/udp_ports.hpp"
 #include "hil/devices/cia402_drive.hpp"
 #include "hil/devices/load_cell.hpp"
 
@@ -36,11 +37,9 @@ namespace sim = tensegrity::hil;  // the emulated devices
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-std::uint16_t free_udp_port() {
-  std::string error;
-  auto probe = UdpCanBus::open({{"127.0.0.1", 9}, {"127.0.0.1", 0}}, error);
-  return probe ? probe->local_port() : 0;  // closed again here; the race is harmless on loopback
-}
+// Below the ephemeral range: a port bound to 0 and released for the end cap could
+// go to any other socket binding 0 (a DDS participant of a test beside) first.
+std::uint16_t free_udp_port() { return sim::free_udp_ports(1).at(0); }
 
 class ChildProcess {
  public:

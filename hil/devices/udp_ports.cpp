@@ -8,9 +8,10 @@
 #include <cstring>
 #include <fstream>
 #include <random>
+#include <stdexcept>
+#include <string>
 
-#include "hil/hil_error.hpp"
-#include "hil/process_launcher.hpp"
+#include "hil/devices/udp_ports.hpp"
 
 namespace tensegrity::hil {
 namespace {
@@ -43,7 +44,7 @@ std::vector<std::uint16_t> free_udp_ports(int count) {
     const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     if (fd < 0) {
       release();
-      throw HilError(std::string("cannot open a UDP socket: ") + std::strerror(errno));
+      throw std::runtime_error(std::string("cannot open a UDP socket: ") + std::strerror(errno));
     }
     sockaddr_in addr{};
     addr.sin_family = AF_INET;
@@ -58,8 +59,8 @@ std::vector<std::uint16_t> free_udp_ports(int count) {
   }
   release();
   if (static_cast<int>(ports.size()) < count) {
-    throw HilError("cannot find " + std::to_string(count) + " free UDP ports in 127.0.0.1:" + std::to_string(low) +
-                   ".." + std::to_string(high - 1));
+    throw std::runtime_error("cannot find " + std::to_string(count) +
+                             " free UDP ports in 127.0.0.1:" + std::to_string(low) + ".." + std::to_string(high - 1));
   }
   return ports;
 }
