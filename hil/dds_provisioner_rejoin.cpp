@@ -20,10 +20,11 @@ namespace tensegrity::hil {
 namespace {
 
 constexpr auto kSupervisePeriod = std::chrono::milliseconds(20);
-// Lockstep: how long after its spawn an end cap started on boot is still the
-// launcher's to stop. An estop that reached the others before the spawn is heard
-// within one heartbeat period (0.2 s) of it; one after the spawn reaches the new
-// program through the operator's tool once the program is on the link.
+// Lockstep: an end cap started on boot is the launcher's to stop until its new life
+// is heard on the link and at least this long after its spawn. An estop that
+// reached the others before the spawn is heard within one heartbeat period (0.2 s)
+// of it; one after that reaches the program through the operator's tool, which
+// re-sends until every end cap on the link acks.
 constexpr std::int64_t kRecallWindowNs = 500'000'000;
 
 std::string left_idle(int endcap, int stopped_by) {
@@ -121,10 +122,10 @@ void DdsProvisioner::supervise() {
 }
 
 // Lockstep decided at the spawn that the program starts on boot. An estop the
-// launcher hears within kRecallWindowNs of that may have reached the others before
-// the spawn, and the operator's tool may be done before the new program is on the
-// link: the launcher stops it (idle, as if it had been left idle), re-sending until
-// it acks. After the window it is the operator's, as any playing end cap is.
+// launcher hears in the recall window (kRecallWindowNs) may have reached the others
+// before the spawn, and the operator's tool may be done before the new program is on
+// the link: the launcher stops it (idle, as if it had been left idle), re-sending
+// until it acks. After the window it is the operator's, as any playing end cap is.
 void DdsProvisioner::recall(int e, std::int64_t since, const ground::EndcapStatus& s) {
   const int stopped_by = operator_stop();
   if (stopped_by < 0) {
