@@ -27,6 +27,10 @@ on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m). An arm
 its directory, or the arm.csv it wrote (as kept in docs/results/arms/), so a
 recorded arm can be the control of one run on another machine:
   tools/arm.py --compare docs/results/arms/ode-replica-5000.csv out/arms/pop40 --out C
+
+An arm too long for one sitting is kept with --pack DIR (tools/arm_keep.py) and carried
+on elsewhere: copy DIR to a new --out and run the same command; each seed resumes from
+its packed checkpoint, also with a larger --episodes.
 """
 import argparse
 import concurrent.futures
@@ -38,6 +42,7 @@ import statistics
 import subprocess
 import sys
 
+import arm_keep
 import arm_stats
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -65,6 +70,9 @@ def parse_args():
     p.add_argument("--at", type=int, action="append", default=None,
                    help="budgets to summarise at (default: 1000, 2500, 5000 up to --episodes)")
     p.add_argument("--summary-only", action="store_true", help="summarise the runs there, run nothing")
+    p.add_argument("--pack", metavar="DIR",
+                   help="then copy the arm's runs to DIR to keep in the repository: curves, policies, summaries "
+                        "and checkpoints (xz); an arm started from such a copy resumes each seed where it stopped")
     p.add_argument("--compare", nargs="+", metavar="ARM",
                    help="compare finished arms (directories, or their recorded arm.csv) instead of running "
                         "one; the first is the control")
@@ -100,6 +108,7 @@ def write_robot(args, out):
 def run_seed(args, robot, seed):
     run = pathlib.Path(args.out) / "runs" / f"s{seed}"
     run.mkdir(parents=True, exist_ok=True)
+    arm_keep.unpack_checkpoint(run)
     summary = run / "summary.json"
     if summary.exists() and json.loads(summary.read_text()).get("episodes", 0) >= args.episodes:
         return seed, "reused"
@@ -374,6 +383,8 @@ def main():
         print(f"{out.name} at {at['budget']}: median {at['median_m']:.2f} m [{at['q1_m']:.2f}, {at['q3_m']:.2f}], "
               f">=28 m {at['seeds_ge_28']}/{at['seeds']}, >=32 m {at['seeds_ge_32']}/{at['seeds']}, "
               f"first 32 m at {at['first_episode_32m']}")
+    if args.pack:
+        print(f"{out.name}: packed {len(arm_keep.pack(out, args.pack))} seeds into {args.pack}")
 
 
 if __name__ == "__main__":

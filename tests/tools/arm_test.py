@@ -14,6 +14,7 @@ import unittest
 
 TOOLS = pathlib.Path(sys.argv.pop(1) if len(sys.argv) > 1 else pathlib.Path(__file__).parents[2] / "tools")
 sys.path.insert(0, str(TOOLS))
+import arm_keep  # noqa: E402
 import arm_stats  # noqa: E402
 
 
@@ -128,6 +129,38 @@ class Compare(unittest.TestCase):
                 self.assertNotEqual(refused.returncode, 0)
                 self.assertIn(says, refused.stderr)
                 self.assertNotIn("Traceback", refused.stderr)
+
+
+class Keep(unittest.TestCase):
+    def test_packed_runs_restore_the_checkpoint_byte_for_byte(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            root = pathlib.Path(tmp)
+            arm = write_arm(root, "arm", [(5.0, None), (6.0, 800)])
+            (arm / "robot.json").write_text('{"name": "r"}\n')
+            checkpoint = '{"generation": 40, "members": [' + ", ".join(["0.85"] * 5000) + "]}\n"
+            for s in (1, 2):
+                run = arm / "runs" / f"s{s}"
+                (run / "ckpt").mkdir()
+                (run / "ckpt" / "checkpoint.json").write_text(checkpoint.replace("40", str(39 + s)))
+                (run / "ckpt" / "checkpoint.prev.json").write_text("older")
+                (run / "stderr.log").write_text("")
+            subprocess.run([sys.executable, str(TOOLS / "arm.py"), "--out", str(arm), "--summary-only",
+                            "--at", "1000", "--pack", str(root / "kept")], capture_output=True, check=True)
+            kept = root / "kept"
+            self.assertEqual((kept / "robot.json").read_text(), '{"name": "r"}\n')
+            self.assertTrue((kept / "arm.csv").exists())
+            for s in (1, 2):
+                run = kept / "runs" / f"s{s}"
+                self.assertEqual(sorted(p.name for p in run.iterdir()), ["ckpt", "curve.csv"])
+                packed = run / "ckpt" / "checkpoint.json.xz"
+                self.assertEqual([p.name for p in (run / "ckpt").iterdir()], [packed.name])
+                self.assertLess(packed.stat().st_size, len(checkpoint) // 5)
+                self.assertTrue(arm_keep.unpack_checkpoint(run))
+                self.assertEqual((run / "ckpt" / "checkpoint.json").read_text(),
+                                 checkpoint.replace("40", str(39 + s)))
+                self.assertFalse(arm_keep.unpack_checkpoint(run))  # a checkpoint already there is kept
+            with self.assertRaises(ValueError):
+                arm_keep.pack(arm, arm)
 
 
 if __name__ == "__main__":
