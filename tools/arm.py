@@ -108,7 +108,10 @@ def write_robot(args, out):
 def run_seed(args, robot, seed):
     run = pathlib.Path(args.out) / "runs" / f"s{seed}"
     run.mkdir(parents=True, exist_ok=True)
-    arm_keep.unpack_checkpoint(run)
+    try:
+        arm_keep.unpack_checkpoint(run)
+    except ValueError as e:
+        return seed, f"FAILED: {e}"
     summary = run / "summary.json"
     if summary.exists() and json.loads(summary.read_text()).get("episodes", 0) >= args.episodes:
         return seed, "reused"
@@ -364,6 +367,8 @@ def plot_compare(out, arms):
 
 def main():
     args = parse_args()
+    if args.compare and args.pack:
+        sys.exit("--pack keeps one arm's runs; it does not go with --compare")
     if args.compare:
         compare(args)
         return

@@ -20,7 +20,11 @@ def unpack_checkpoint(run):
     ckpt = pathlib.Path(run) / "ckpt"
     packed, plain = ckpt / "checkpoint.json.xz", ckpt / "checkpoint.json"
     if packed.exists() and not plain.exists():
-        plain.write_bytes(lzma.decompress(packed.read_bytes()))
+        try:
+            text = lzma.decompress(packed.read_bytes())
+        except lzma.LZMAError as e:  # the packed copy stays as it was, for another try
+            raise ValueError(f"{packed}: not a readable xz checkpoint ({e})") from None
+        plain.write_bytes(text)
         return True
     return False
 

@@ -161,6 +161,14 @@ class Keep(unittest.TestCase):
                 self.assertFalse(arm_keep.unpack_checkpoint(run))  # a checkpoint already there is kept
             with self.assertRaises(ValueError):
                 arm_keep.pack(arm, arm)
+            # A damaged packed checkpoint is named, and left for another try.
+            damaged = kept / "runs" / "s1" / "ckpt"
+            (damaged / "checkpoint.json").unlink()
+            (damaged / "checkpoint.json.xz").write_bytes(b"not xz")
+            with self.assertRaisesRegex(ValueError, "s1/ckpt/checkpoint.json.xz: not a readable xz"):
+                arm_keep.unpack_checkpoint(kept / "runs" / "s1")
+            self.assertEqual((damaged / "checkpoint.json.xz").read_bytes(), b"not xz")
+            self.assertFalse((damaged / "checkpoint.json").exists())
 
 
 if __name__ == "__main__":
