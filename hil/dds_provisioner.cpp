@@ -45,6 +45,8 @@ DdsProvisioner::DdsProvisioner(const sim::Robot& robot, const sim::Policy& polic
       config_(config),
       lease_(config.domain),
       restarted_at_ns_(static_cast<std::size_t>(robot.endcap_count()), 0),
+      retry_(static_cast<std::size_t>(robot.endcap_count()),
+             config.mode == StepperMode::lockstep ? RetryBackoff(0, 0) : RetryBackoff()),
       withheld_by_(static_cast<std::size_t>(robot.endcap_count()), -1) {
   if (robot.endcap_count() > ground::kEndcapCount) {
     throw HilError("the DDS link addresses at most " + std::to_string(ground::kEndcapCount) + " end caps");

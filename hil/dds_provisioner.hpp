@@ -34,6 +34,7 @@
 #include "firmware/comms/start_grid.hpp"
 #include "ground/station.hpp"
 #include "hil/dds_domain.hpp"
+#include "hil/retry_backoff.hpp"
 #include "hil/provisioner.hpp"
 #include "hil/start_handshake.hpp"
 #include "hil/world_stepper.hpp"
@@ -144,6 +145,9 @@ class DdsProvisioner final : public Provisioner {
   // Per end cap: host time of a restart the supervisor still watches (0: none); real
   // time: not yet started; lockstep: started on boot, in its recall window.
   std::vector<std::int64_t> restarted_at_ns_;
+  // Per end cap: its refusals of the supervisor's start (real time) or stop (lockstep's
+  // recall: a stop is never held back, only its log lines thinned). Supervisor thread.
+  std::vector<RetryBackoff> retry_;
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
   std::int64_t run_begun_ns_ = 0;               // host clock at begin_run (the supervisor's start)

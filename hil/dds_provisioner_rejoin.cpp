@@ -32,6 +32,17 @@ std::string left_idle(int endcap, int stopped_by) {
          std::to_string(stopped_by) + " took an emergency stop; starting it again is the operator's: tensegrity start)";
 }
 
+std::string first_answer(const ground::CommandReport& r) {
+  return r.results.empty() ? std::string("no answer") : r.results[0].text;
+}
+
+// For the line that settles a restart: how often the order was refused first, if at all.
+std::string refusals_before(const RetryBackoff& retry, const char* order) {
+  if (retry.refusals() == 0) return "";
+  return " (after " + std::to_string(retry.refusals()) + " refused " + order + "(s); last: " + retry.last_reason() +
+         ")";
+}
+
 }  // namespace
 
 int DdsProvisioner::operator_stop() const { return operator_stop(station_->snapshot()); }
@@ -87,6 +98,23 @@ void DdsProvisioner::end_run() {
   if (!supervisor_.joinable()) return;
   supervisor_.join();
   run_ended_ns_ = ground::Station::now_ns();
+  // A restart still pending that was refused: the run's log says so once, with the count.
+  std::vector<int> refused;
+  {
+    std::lock_guard lock(mutex_);
+    for (std::size_t e = 0; e < restarted_at_ns_.size(); ++e) {
+      const RetryBackoff& r = retry_[e];
+      if (restarted_at_ns_[e] != 0 && r.restart_ns() == restarted_at_ns_[e] && r.refusals() > 0)
+        refused.push_back(static_cast<int>(e));
+    }
+  }
+  for (const int e : refused) {
+    const RetryBackoff& r = retry_[static_cast<std::size_t>(e)];
+    const bool realtime = config_.mode == StepperMode::realtime;
+    note("dds: end cap " + std::to_string(e) + " back after a restart: " +
+         (realtime ? "not started by the run's end; its start" : "not stopped by the run's end; its stop") +
+         " was refused " + std::to_string(r.refusals()) + " time(s) (last: " + r.last_reason() + ")");
+  }
 }
 
 void DdsProvisioner::settle_restart(int endcap, std::int64_t since, const std::string& line) {
@@ -112,6 +140,7 @@ void DdsProvisioner::supervise() {
       }
     }
     for (const auto& [e, since] : pending) {
+      retry_[static_cast<std::size_t>(e)].follow(since);
       if (config_.mode == StepperMode::realtime) {
         rejoin(e, since, status[e]);
       } else {
@@ -137,14 +166,16 @@ void DdsProvisioner::recall(int e, std::int64_t since, const ground::EndcapStatu
   co.endcap_mask = static_cast<std::uint16_t>(1U << e);
   co.timeout_s = config_.command_timeout_s;
   const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::stop, 0, co);
+  RetryBackoff& retry = retry_[static_cast<std::size_t>(e)];
   if (r.all_accepted()) {
     settle_restart(e, since,
                    "dds: end cap " + std::to_string(e) +
                        " back after a restart: stopped (it started on boot as end cap " + std::to_string(stopped_by) +
-                       " took an emergency stop; starting it again is the operator's: tensegrity start)");
-  } else {
-    note("dds: end cap " + std::to_string(e) + " back after a restart: stop not accepted (" +
-         (r.results.empty() ? std::string("no answer") : r.results[0].text) + "); trying again");
+                       " took an emergency stop; starting it again is the operator's: tensegrity start)" +
+                       refusals_before(retry, "stop"));
+  } else if (retry.refused(ground::Station::now_ns(), first_answer(r))) {
+    note("dds: end cap " + std::to_string(e) + " back after a restart: stop not accepted (" + retry.last_reason() +
+         "; " + std::to_string(retry.refusals()) + " time(s) so far); trying again");
   }
 }
 
@@ -174,7 +205,8 @@ void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatu
   const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
                      s.telemetry_host_ns > since && s.telemetry.drives_enabled() && s.telemetry.mode() == 0 &&
                      s.telemetry.fault() == 0;
-  if (!ready) return;
+  RetryBackoff& retry = retry_[static_cast<std::size_t>(e)];
+  if (!ready || !retry.due(ground::Station::now_ns())) return;
   // Its phase is as good as its clock: give the time sync a moment.
   const double round_trip_s =
       settle_time_sync(static_cast<std::uint16_t>(1U << e),
@@ -195,10 +227,12 @@ void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatu
                   "dds: end cap %d back after a restart: started at the run's start time (table %.3f s along; "
                   "time-sync round trip %.3f ms)",
                   e, behind_s, round_trip_s * 1e3);
-    settle_restart(e, since, line);
-  } else {
-    std::snprintf(line, sizeof line, "dds: end cap %d back after a restart: start not accepted (%s); trying again", e,
-                  r.results.empty() ? "no answer" : r.results[0].text.c_str());
+    settle_restart(e, since, line + refusals_before(retry, "start"));
+  } else if (retry.refused(ground::Station::now_ns(), first_answer(r))) {
+    std::snprintf(line, sizeof line,
+                  "dds: end cap %d back after a restart: start not accepted (%s; %d time(s) so far); trying again "
+                  "in %.2f s",
+                  e, retry.last_reason().c_str(), retry.refusals(), static_cast<double>(retry.wait_ns()) * 1e-9);
     note(line);
   }
 }
