@@ -34,8 +34,8 @@
 #include "firmware/comms/start_grid.hpp"
 #include "ground/station.hpp"
 #include "hil/dds_domain.hpp"
-#include "hil/retry_backoff.hpp"
 #include "hil/provisioner.hpp"
+#include "hil/retry_backoff.hpp"
 #include "hil/start_handshake.hpp"
 #include "hil/world_stepper.hpp"
 #include "sim/policy.hpp"
@@ -146,7 +146,8 @@ class DdsProvisioner final : public Provisioner {
   // time: not yet started; lockstep: started on boot, in its recall window.
   std::vector<std::int64_t> restarted_at_ns_;
   // Per end cap: its refusals of the supervisor's start (real time) or stop (lockstep's
-  // recall: a stop is never held back, only its log lines thinned). Supervisor thread.
+  // recall: a stop is never held back, only its log lines thinned). The supervisor
+  // thread's; end_run reads it after joining that thread.
   std::vector<RetryBackoff> retry_;
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;

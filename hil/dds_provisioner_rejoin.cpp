@@ -39,8 +39,8 @@ std::string first_answer(const ground::CommandReport& r) {
 // For the line that settles a restart: how often the order was refused first, if at all.
 std::string refusals_before(const RetryBackoff& retry, const char* order) {
   if (retry.refusals() == 0) return "";
-  return " (after " + std::to_string(retry.refusals()) + " refused " + order + "(s); last: " + retry.last_reason() +
-         ")";
+  return " (after " + std::to_string(retry.refusals()) + " " + order +
+         "(s) not accepted; last: " + retry.last_reason() + ")";
 }
 
 }  // namespace
@@ -113,7 +113,7 @@ void DdsProvisioner::end_run() {
     const bool realtime = config_.mode == StepperMode::realtime;
     note("dds: end cap " + std::to_string(e) + " back after a restart: " +
          (realtime ? "not started by the run's end; its start" : "not stopped by the run's end; its stop") +
-         " was refused " + std::to_string(r.refusals()) + " time(s) (last: " + r.last_reason() + ")");
+         " was not accepted " + std::to_string(r.refusals()) + " time(s) (last: " + r.last_reason() + ")");
   }
 }
 
@@ -166,6 +166,8 @@ void DdsProvisioner::recall(int e, std::int64_t since, const ground::EndcapStatu
   co.endcap_mask = static_cast<std::uint16_t>(1U << e);
   co.timeout_s = config_.command_timeout_s;
   const ground::CommandReport r = ground::send_command(*station_, ground::CommandKind::stop, 0, co);
+  // Never gated by retry.due(): a stop must not wait (the others are already stopped);
+  // the backoff only thins its log lines.
   RetryBackoff& retry = retry_[static_cast<std::size_t>(e)];
   if (r.all_accepted()) {
     settle_restart(e, since,
@@ -180,15 +182,18 @@ void DdsProvisioner::recall(int e, std::int64_t since, const ground::EndcapStatu
 }
 
 void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatus& s) {
+  RetryBackoff& retry = retry_[static_cast<std::size_t>(e)];
   if (s.have_telemetry && s.telemetry_host_ns > since && s.telemetry.mode() == 1) {
     // Its commands reader is volatile, so only a start sent after it came back
     // (an operator's `tensegrity start`) can have set it playing. Nothing left to do.
-    settle_restart(e, since, "dds: end cap " + std::to_string(e) + " back after a restart: already playing");
+    settle_restart(e, since,
+                   "dds: end cap " + std::to_string(e) + " back after a restart: already playing" +
+                       refusals_before(retry, "start"));
     return;
   }
   // Checked at every step: an estop may land while the end cap is coming back.
   if (const int stopped_by = operator_stop(); stopped_by >= 0) {
-    settle_restart(e, since, left_idle(e, stopped_by));
+    settle_restart(e, since, left_idle(e, stopped_by) + refusals_before(retry, "start"));
     return;
   }
   // The clear names the estops this life took: wait for its own heartbeat.
@@ -198,14 +203,15 @@ void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatu
     // end cap it does not clear (an operator's estop) is left as it is.
     if (!clear_faults_before_start(static_cast<std::uint16_t>(1U << e),
                                    ground::Station::now_ns() + core::seconds_to_ns(config_.command_timeout_s))) {
-      settle_restart(e, since, "");
+      // clear_faults_before_start said why; only the starts not accepted before are left to say.
+      const std::string before = refusals_before(retry, "start");
+      settle_restart(e, since, before.empty() ? "" : "dds: end cap " + std::to_string(e) + " left faulted" + before);
     }
     return;
   }
   const bool ready = s.seen && s.heartbeat_host_ns > since && s.heartbeat.clock_synced() && s.have_telemetry &&
                      s.telemetry_host_ns > since && s.telemetry.drives_enabled() && s.telemetry.mode() == 0 &&
                      s.telemetry.fault() == 0;
-  RetryBackoff& retry = retry_[static_cast<std::size_t>(e)];
   if (!ready || !retry.due(ground::Station::now_ns())) return;
   // Its phase is as good as its clock: give the time sync a moment.
   const double round_trip_s =
@@ -213,7 +219,7 @@ void DdsProvisioner::rejoin(int e, std::int64_t since, const ground::EndcapStatu
                        ground::Station::now_ns() + core::seconds_to_ns(config_.rejoin_sync_settle_timeout_s));
   // The last look before it moves: an estop in the settling time still wins.
   if (const int stopped_by = operator_stop(); stopped_by >= 0) {
-    settle_restart(e, since, left_idle(e, stopped_by));
+    settle_restart(e, since, left_idle(e, stopped_by) + refusals_before(retry, "start"));
     return;
   }
   ground::CommandOptions co;

@@ -20,11 +20,13 @@ void RetryBackoff::follow(std::int64_t restart_ns) {
 
 bool RetryBackoff::refused(std::int64_t now_ns, std::string reason) {
   ++refusals_;
+  const bool new_reason = reason != last_reason_;
   last_reason_ = std::move(reason);
   wait_ns_ = wait_ns_ == 0 ? first_wait_ns_ : std::min(2 * wait_ns_, max_wait_ns_);
   next_try_ns_ = now_ns + wait_ns_;
-  // Powers of two: a handful of lines however long it goes on, the first one at once.
-  return (refusals_ & (refusals_ - 1)) == 0;
+  // Powers of two: a handful of lines however long it goes on, the first one at once;
+  // and a reason that changed, which is news.
+  return new_reason || (refusals_ & (refusals_ - 1)) == 0;
 }
 
 }  // namespace tensegrity::hil

@@ -3,7 +3,8 @@
 // an order (or did not answer). A refusal is acknowledged at once, so without a
 // wait an end cap that keeps refusing would get the order at every supervisor
 // tick (50 Hz) with a log line each. The wait doubles from first_wait_ns up to
-// max_wait_ns; the log keeps the 1st, 2nd, 4th, 8th ... refusal and the count.
+// max_wait_ns; the log keeps the 1st, 2nd, 4th, 8th ... refusal, and one whose
+// reason differs from the last, with the count.
 // One per end cap, keyed by the restart it belongs to: a new restart starts afresh.
 #pragma once
 

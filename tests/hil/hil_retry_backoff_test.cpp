@@ -42,9 +42,8 @@ TEST(RetryBackoff, AMinuteOfRefusalsIsAFewTriesAndFewerLines) {
     if (r.refused(now, "no answer")) ++lines;
   }
   EXPECT_EQ(tries, r.refusals());
-  EXPECT_GE(tries, 30);  // after 0.25, 0.5 and 1 s, then every 2 s
-  EXPECT_LE(tries, 35);
-  EXPECT_EQ(lines, 6);  // refusals 1, 2, 4, 8, 16, 32
+  EXPECT_EQ(tries, 33);  // at 0, 0.26, 0.76, 1.76 s (on the tick after each wait), then every 2 s to 59.76 s
+  EXPECT_EQ(lines, 6);   // refusals 1, 2, 4, 8, 16, 32
 }
 
 TEST(RetryBackoff, ANewRestartStartsAfresh) {
@@ -62,8 +61,21 @@ TEST(RetryBackoff, ANewRestartStartsAfresh) {
   EXPECT_TRUE(r.refused(0, "stale"));  // its first refusal is logged again
 }
 
-// Lockstep's recall stops an end cap that started on boot after an estop: a stop is
-// never held back, only its log lines are thinned.
+// Thinning keeps a reason that changed: a start refused as stale, then unanswered.
+TEST(RetryBackoff, AChangedReasonIsLogged) {
+  RetryBackoff r(0, 0);
+  r.follow(1);
+  const bool expected[] = {true, true, false, true, false};  // 1st, 2nd, 4th
+  for (const bool e : expected) EXPECT_EQ(r.refused(0, "stale"), e);
+  EXPECT_TRUE(r.refused(0, "no acknowledgement"));   // the 6th, a new reason
+  EXPECT_FALSE(r.refused(0, "no acknowledgement"));  // the 7th
+  EXPECT_EQ(r.refusals(), 7);
+  EXPECT_EQ(r.last_reason(), "no acknowledgement");
+}
+
+// Lockstep's recall stops an end cap that started on boot after an estop. recall()
+// never asks due() (a stop must not wait); this pins that a zero wait, its
+// backoff's, would not hold one back either, and thins the lines all the same.
 TEST(RetryBackoff, AZeroWaitNeverHoldsAStopBack) {
   RetryBackoff r(0, 0);
   r.follow(1);
