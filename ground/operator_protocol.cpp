@@ -31,7 +31,7 @@ const char* relayed_name(CommandKind kind) {
   }
   throw std::invalid_argument("operator link: a console relays estop, stop and clear-fault only");
 }
-constexpr std::uint8_t kLastReason = static_cast<std::uint8_t>(fw::comms::CommandReason::estop_unseen);
+constexpr std::uint8_t kLastReason = static_cast<std::uint8_t>(fw::comms::CommandReason::no_table);
 
 Reader top_level(const json& j, const char* what) {
   Reader r(j, what, "");

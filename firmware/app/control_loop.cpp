@@ -301,6 +301,7 @@ void ControlLoop::publish(std::int64_t time_ns, const core::StepStatus& step) {
   t.subinterval = step.subinterval;
   t.cutoff_mask = step.cutoff_mask;
   t.drives_enabled = drives_enabled();
+  t.has_table = controller_.has_table();
   for (std::uint32_t m = 0; m < settings_.core.motor_count; ++m) {
     t.commanded_rest_length_m[m] = commanded_m_[m];
     t.measured_rest_length_m[m] = master_.drive(m).rest_length_m;

@@ -45,6 +45,7 @@ struct Telemetry {
   std::uint32_t subinterval = 0;
   std::uint8_t cutoff_mask = 0;
   bool drives_enabled = false;  // bring-up done and every drive in operation enabled
+  bool has_table = false;       // a policy table is loaded (a start can play)
   std::array<double, core::kMaxMotorsPerEndcap> commanded_rest_length_m{};
   std::array<double, core::kMaxMotorsPerEndcap> measured_rest_length_m{};
   std::array<double, core::kMaxMotorsPerEndcap> tension_n{};

@@ -128,7 +128,8 @@ void EndcapNode::publish(const app::Telemetry& telemetry) noexcept {
   // Stamped with the node's clock so the node can map loop time <-> its own time.
   const std::int64_t now = clock_.now_ns();
   telemetry_in_.write(StampedTelemetry{telemetry, now});
-  loop_clock_in_.write(LoopClockPoint{telemetry.time_ns, now});
+  loop_in_.write(LoopPoint{LoopClockPoint{telemetry.time_ns, now},
+                           LoopReadiness{telemetry.drives_enabled, telemetry.fault, telemetry.has_table}});
 }
 
 ActivePolicy EndcapNode::active_policy() const {

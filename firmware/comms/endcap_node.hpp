@@ -34,6 +34,7 @@
 #include "firmware/comms/command_gate.hpp"
 #include "firmware/comms/node_config.hpp"
 #include "firmware/comms/policy_wire.hpp"
+#include "firmware/comms/start_readiness.hpp"
 #include "firmware/comms/start_time.hpp"
 #include "firmware/comms/time_sync_client.hpp"
 #include "firmware/hal/clock.hpp"
@@ -151,10 +152,15 @@ class EndcapNode final : public app::HostLink {
   app::SpscRing<app::HostTable, 4> tables_;
   app::SpscRing<app::HostCommand, 16> commands_;  // producer: the command listener only
   app::LatestValue<StampedTelemetry> telemetry_in_;
-  // The loop's clock for the command listener, its own copy: a start is mapped on
-  // the receive thread, and the node thread's last telemetry may be many loop
-  // cycles old there (lockstep runs its cycles faster than the node wakes).
-  app::LatestValue<LoopClockPoint> loop_clock_in_;
+  // The loop's clock and readiness for the command listener, its own copy: a start
+  // is mapped and judged on the receive thread, and the node thread's last telemetry
+  // may be many loop cycles old there (lockstep runs its cycles faster than the node
+  // wakes).
+  struct LoopPoint {
+    LoopClockPoint clock;
+    LoopReadiness ready;
+  };
+  app::LatestValue<LoopPoint> loop_in_;
   std::atomic<std::uint32_t> estops_{0};
   // Drawn at start, never 0 (a host's value): names this life's estop count on the
   // wire, so a clear-fault that saw an earlier life's count cannot match.
@@ -203,7 +209,7 @@ class EndcapNode final : public app::HostLink {
   std::mutex receive_mutex_;
   CommandGate gate_;
   StartTimeMapper start_mapper_;
-  LoopClockPoint loop_point_{};
+  LoopPoint loop_point_{};
   bool loop_point_valid_ = false;
 
   // Shared between the node thread and the listeners.

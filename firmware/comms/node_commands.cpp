@@ -91,14 +91,16 @@ CommandReason EndcapNode::act_on(const CommandSample& c, WireCommandKind kind) {
   out.kind = static_cast<app::CommandKind>(kind);
   if (kind == WireCommandKind::start) {
     // The loop's latest cycle, not the node thread's last look at it.
-    if (LoopClockPoint p; loop_clock_in_.read(p)) {
+    if (LoopPoint p; loop_in_.read(p)) {
       loop_point_ = p;
       loop_point_valid_ = true;
     }
     std::lock_guard lock(mutex_);
     if (!sync_.estimator().synced()) return CommandReason::clock_not_synced;
     if (!loop_point_valid_) return CommandReason::loop_not_running;
-    const auto start = start_mapper_.map(c.start_host_time_ns, sync_.estimator().best().offset_ns, loop_point_);
+    // Said in the ack rather than found out by the loop a cycle later, unseen.
+    if (const CommandReason ready = start_readiness(loop_point_.ready); ready != CommandReason::accepted) return ready;
+    const auto start = start_mapper_.map(c.start_host_time_ns, sync_.estimator().best().offset_ns, loop_point_.clock);
     if (!start) return CommandReason::bad_time;
     out.start_time_ns = *start;
   }

@@ -62,6 +62,10 @@ const char* describe(CommandReason reason) noexcept {
     case CommandReason::bad_time: return "start time outside the valid range";
     case CommandReason::estop_unseen:
       return "an emergency stop reached this end cap after the sender last heard it: look again, then clear";
+    case CommandReason::fault_latched: return "a fault is latched: the start would not play (tensegrity clear-fault)";
+    case CommandReason::drives_not_enabled:
+      return "drives not enabled (bring-up not done, or a drive not in operation enabled): the start would not play";
+    case CommandReason::no_table: return "no policy table loaded: the start would not play (tensegrity upload)";
   }
   return "unknown reason";
 }

@@ -41,6 +41,10 @@ enum class CommandReason : std::uint8_t {
   stale = 7,             // a start issued longer ago than command_max_age_s (host time)
   bad_time = 8,          // a start's host time is outside the valid range
   estop_unseen = 9,      // a clear-fault sent before an emergency stop it had not seen
+  // A start the control loop could not play (start_readiness.hpp), as it last published itself:
+  fault_latched = 10,       // a fault is latched: the operator clears it first
+  drives_not_enabled = 11,  // bring-up not done, or a drive not in operation enabled
+  no_table = 12,            // no policy table loaded
 };
 
 const char* describe(PolicyReason reason) noexcept;

@@ -28,6 +28,7 @@ namespace tensegrity::ground {
 namespace {
 
 namespace fs = std::filesystem;
+using fw::comms::CommandReason;
 using fw::comms::PolicyReason;
 using test::Subprocess;
 
@@ -154,6 +155,12 @@ TEST_F(GroundDds, EveryBadPolicyIsRejectedWithItsReasonAndTheOldOneKeepsRunning)
   start_nodes(kDomain);
   Station& s = station(kDomain);
   ASSERT_TRUE(s.wait_for_endcaps(kAllEndcaps, true, Station::now_ns() + seconds(15)));
+  // Before any table: the start is refused with its reason (the loop could not play it).
+  const CommandReport early = send_command(s, CommandKind::start, Station::now_ns() + seconds(0.2), {});
+  for (const auto& r : early.results) {
+    EXPECT_TRUE(r.acked && !r.accepted) << "end cap " << r.endcap;
+    EXPECT_EQ(r.reason, CommandReason::no_table) << "end cap " << r.endcap << ": " << r.text;
+  }
   ASSERT_TRUE(upload(s, messages(make_policy(), 5), UploadOptions{}).all_accepted());
   const CommandReport start = send_command(s, CommandKind::start, Station::now_ns() + seconds(0.2), {});
   ASSERT_TRUE(start.all_accepted()) << format_command_report(start);

@@ -128,6 +128,7 @@ void StubLoop::cycle(std::int64_t loop_ns, double dt_s) {
   t.subinterval = step.subinterval;
   t.cutoff_mask = step.cutoff_mask;
   t.drives_enabled = true;
+  t.has_table = controller_.has_table();
   for (std::uint32_t m = 0; m < n; ++m) {
     t.commanded_rest_length_m[m] = commanded_[m];
     t.measured_rest_length_m[m] = commanded_[m];  // ideal plant
