@@ -172,6 +172,18 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   std::printf("MEASURE discovery of 12 end-cap processes: %.0f ms\n",
               static_cast<double>(Station::now_ns() - t0) / 1e6);
 
+  // 0. A start before any policy is refused with its reason, not acked and left idle.
+  ASSERT_TRUE(wait_all([](const EndcapStatus& s) { return s.have_telemetry && s.telemetry.drives_enabled(); }, 15.0))
+      << "drives not enabled on every end cap";
+  std::string refused;
+  EXPECT_EQ(tensegrity({"start", "--at", "+1", "--timeout", "10"}, refused), 1);
+  std::size_t no_table = 0;
+  for (std::size_t at = refused.find("no policy table loaded"); at != std::string::npos;
+       at = refused.find("no policy table loaded", at + 1)) {
+    ++no_table;
+  }
+  EXPECT_EQ(no_table, static_cast<std::size_t>(kEndcapCount)) << refused;
+
   // 1. Upload through the program an operator uses.
   const fs::path policy = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
   std::string out;
