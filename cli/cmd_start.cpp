@@ -2,6 +2,7 @@
 // `tensegrity start [--at +S]`: every end cap starts its table at the same host
 // time, so all 12 play in phase (each maps the host time through its time sync).
 // Success means playing, not acked: the telemetry after the start time is read back.
+#include <algorithm>
 #include <cstdio>
 
 #include "cli/commands.hpp"
@@ -54,7 +55,9 @@ void add_start_command(CLI::App& app) {
     std::printf("waiting up to %.1f s after the start time for telemetry that shows every end cap playing\n",
                 args->confirm_within_s);
     std::fflush(stdout);
-    const std::int64_t deadline = t + static_cast<std::int64_t>(args->confirm_within_s * 1e9);
+    // From the start time, or from the last ack when the acks took longer than the lead.
+    const std::int64_t deadline =
+        std::max(t, ground::Station::now_ns()) + static_cast<std::int64_t>(args->confirm_within_s * 1e9);
     const auto checks = ground::wait_playing(*station, options.endcap_mask, t, deadline);
     std::printf("%s", ground::format_playing(checks).c_str());
     if (!ground::all_playing(checks)) {

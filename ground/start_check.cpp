@@ -5,12 +5,13 @@
 #include <chrono>
 #include <thread>
 
+#include "firmware/core/endcap_controller.hpp"
 #include "ground/status.hpp"
 
 namespace tensegrity::ground {
 
 namespace {
-constexpr std::uint8_t kRunning = 1;  // Telemetry_::mode, as status.cpp's mode_name
+constexpr auto kRunning = static_cast<std::uint8_t>(core::Mode::running);  // Telemetry_::mode
 }
 
 std::vector<PlayingCheck> check_playing(const std::array<EndcapStatus, kEndcapCount>& status, std::uint16_t mask,
@@ -21,7 +22,7 @@ std::vector<PlayingCheck> check_playing(const std::array<EndcapStatus, kEndcapCo
     const EndcapStatus& s = status[static_cast<std::size_t>(e)];
     PlayingCheck c;
     c.endcap = e;
-    c.heard = s.have_telemetry && s.telemetry_host_ns > start_ns;
+    c.heard = s.have_telemetry && s.telemetry.host_time_ns() >= start_ns;
     c.playing = c.heard && s.telemetry.mode() == kRunning;
     if (c.heard) {
       c.state = std::string(mode_name(s.telemetry.mode()));

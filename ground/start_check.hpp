@@ -18,12 +18,14 @@ namespace tensegrity::ground {
 struct PlayingCheck {
   int endcap = 0;
   bool playing = false;
-  bool heard = false;  // telemetry sent after the start time arrived
-  std::string state;   // what that telemetry said, for the report ("idle, fault drive_lost, drives off")
+  bool heard = false;  // telemetry sampled at or after the start time arrived
+  std::string state;   // what that telemetry said, for the report ("idle, fault drive_lost, drives not enabled")
 };
 
-// One entry per end cap in `mask`, in order: playing when its newest telemetry
-// arrived after `start_ns` (host clock) and shows it running.
+// One entry per end cap in `mask`, in order: playing when its newest telemetry was
+// sampled at or after `start_ns` (its own host-time stamp, Telemetry_::host_time_ns:
+// a sample of an end cap already running, sent before the start and arriving after
+// it, says nothing about the start) and shows it running.
 std::vector<PlayingCheck> check_playing(const std::array<EndcapStatus, kEndcapCount>& status, std::uint16_t mask,
                                         std::int64_t start_ns);
 
@@ -32,7 +34,7 @@ std::vector<PlayingCheck> wait_playing(const Station& station, std::uint16_t mas
                                        std::int64_t deadline_ns);
 
 bool all_playing(const std::vector<PlayingCheck>& checks);
-// "all 12 end caps playing" or one line per end cap that is not.
+// "12 of 12 end caps playing", then one line per end cap that is not.
 std::string format_playing(const std::vector<PlayingCheck>& checks);
 
 }  // namespace tensegrity::ground

@@ -248,16 +248,20 @@ bool DdsProvisioner::clear_faults_before_start(std::uint16_t mask, std::int64_t 
   std::string which;
   for (int e = 0; e < ground::kEndcapCount; ++e) {
     const ground::EndcapStatus s = station_->snapshot()[e];
-    if ((mask & (1U << e)) == 0 || !s.seen || s.heartbeat.fault() == 0) continue;
+    // Telemetry (100 Hz) shows a fault latched since the last heartbeat (5 Hz): an end
+    // cap refuses a start while one is latched (fault_latched), so none may be missed.
+    const std::uint8_t fault =
+        s.seen && s.heartbeat.fault() != 0 ? s.heartbeat.fault() : (s.have_telemetry ? s.telemetry.fault() : 0);
+    if ((mask & (1U << e)) == 0 || !s.seen || fault == 0) continue;
     // An operator's stop is theirs to clear, never the launcher's (which sends none):
     // any estop this life took, also one latched on top of a milder first fault.
-    if (s.heartbeat.fault() == static_cast<std::uint8_t>(core::FaultCause::emergency_stop) || s.estops.count > 0) {
+    if (fault == static_cast<std::uint8_t>(core::FaultCause::emergency_stop) || s.estops.count > 0) {
       note("dds: end cap " + std::to_string(e) +
            " took an emergency stop: left to the operator (tensegrity clear-fault)");
       return false;
     }
     faulted = static_cast<std::uint16_t>(faulted | (1U << e));
-    which += (which.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(s.heartbeat.fault()) + ")";
+    which += (which.empty() ? "" : ", ") + std::to_string(e) + " (" + ground::fault_name(fault) + ")";
   }
   if (faulted == 0) return true;
   ground::CommandOptions co;

@@ -127,9 +127,11 @@ bool EndcapNode::try_take_command(app::HostCommand& out) noexcept { return comma
 void EndcapNode::publish(const app::Telemetry& telemetry) noexcept {
   // Stamped with the node's clock so the node can map loop time <-> its own time.
   const std::int64_t now = clock_.now_ns();
-  telemetry_in_.write(StampedTelemetry{telemetry, now});
+  // The listener's copy first: the node acks an upload from telemetry_in_, and a start
+  // sent on that ack must find the table in loop_in_.
   loop_in_.write(LoopPoint{LoopClockPoint{telemetry.time_ns, now},
                            LoopReadiness{telemetry.drives_enabled, telemetry.fault, telemetry.has_table}});
+  telemetry_in_.write(StampedTelemetry{telemetry, now});
 }
 
 ActivePolicy EndcapNode::active_policy() const {

@@ -173,8 +173,12 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
               static_cast<double>(Station::now_ns() - t0) / 1e6);
 
   // 0. A start before any policy is refused with its reason, not acked and left idle.
-  ASSERT_TRUE(wait_all([](const EndcapStatus& s) { return s.have_telemetry && s.telemetry.drives_enabled(); }, 15.0))
-      << "drives not enabled on every end cap";
+  ASSERT_TRUE(wait_all(
+      [](const EndcapStatus& s) {
+        return s.have_telemetry && s.telemetry.drives_enabled() && s.telemetry.fault() == 0;
+      },
+      15.0))
+      << "drives not enabled (or a fault latched) on some end cap";
   std::string refused;
   EXPECT_EQ(tensegrity({"start", "--at", "+1", "--timeout", "10"}, refused), 1);
   std::size_t no_table = 0;

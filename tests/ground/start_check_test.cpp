@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // What `tensegrity start` reads back after the acks: an end cap counts as playing
-// only on telemetry sent after the start time that shows it running.
+// only on telemetry sampled at or after the start time that shows it running.
 #include "ground/start_check.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +16,8 @@ EndcapStatus heard(std::int64_t at_ns, std::uint8_t mode, core::FaultCause fault
   EndcapStatus s;
   s.seen = true;
   s.have_telemetry = true;
-  s.telemetry_host_ns = at_ns;
+  s.telemetry_host_ns = at_ns + 2'000'000;  // arrival, a little after the sample
+  s.telemetry.host_time_ns(at_ns);
   s.telemetry.mode(mode);
   s.telemetry.fault(static_cast<std::uint8_t>(fault));
   s.telemetry.drives_enabled(drives);
@@ -30,8 +31,10 @@ TEST(StartCheck, OnlyTelemetryAfterTheStartTimeShowingRunningCounts) {
   status[2] = heard(kStartNs + 10'000'000, 0, core::FaultCause::none, true);  // idle after the start time
   status[3] = heard(kStartNs + 10'000'000, 2, core::FaultCause::drive_lost, false);
   // end cap 4: never heard
-  const auto checks = check_playing(status, 0b11111, kStartNs);
-  ASSERT_EQ(checks.size(), 5u);
+  // end cap 5: running, sampled just before the start, arriving after it: not evidence
+  status[5] = heard(kStartNs - 1'000'000, 1, core::FaultCause::none, true);
+  const auto checks = check_playing(status, 0b111111, kStartNs);
+  ASSERT_EQ(checks.size(), 6u);
   EXPECT_TRUE(checks[0].playing);
   EXPECT_FALSE(checks[1].playing);
   EXPECT_FALSE(checks[1].heard) << "a sample from before the start time says nothing about the start";
@@ -40,9 +43,11 @@ TEST(StartCheck, OnlyTelemetryAfterTheStartTimeShowingRunningCounts) {
   EXPECT_EQ(checks[2].state, "idle");
   EXPECT_EQ(checks[3].state, "faulted, fault drive_lost, drives not enabled");
   EXPECT_FALSE(checks[4].heard);
+  EXPECT_GT(status[5].telemetry_host_ns, kStartNs);
+  EXPECT_FALSE(checks[5].playing) << "arrived after the start time, but sampled before it";
   EXPECT_FALSE(all_playing(checks));
   const std::string report = format_playing(checks);
-  EXPECT_NE(report.find("1 of 5 end caps playing"), std::string::npos) << report;
+  EXPECT_NE(report.find("1 of 6 end caps playing"), std::string::npos) << report;
   EXPECT_NE(report.find("end cap 2: NOT playing (idle)"), std::string::npos) << report;
   EXPECT_NE(report.find("end cap 4: NOT playing (no telemetry since the start time)"), std::string::npos) << report;
   EXPECT_EQ(report.find("end cap 0:"), std::string::npos) << "a playing end cap needs no line";
