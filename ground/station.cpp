@@ -16,6 +16,7 @@
 
 #include "msgs/dds.hpp"
 #include "msgs/endcap_writers.hpp"
+#include "msgs/matched_readers.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
@@ -82,6 +83,7 @@ struct StationListeners {
 struct Station::Dds {
   // Declared first, destroyed last: the participant (deleted in close()) calls it.
   msgs::EndcapWriters writers;
+  msgs::MatchedReaders policy_readers, command_readers;  // the writers' listeners
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -106,8 +108,9 @@ struct Station::Dds {
     msgs::delete_participant(participant);
     participant = nullptr;
   }
-  dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type) {
-    return msgs::create_writer(*participant, *publisher, spec, type);
+  dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type,
+                          dds::DataWriterListener* listener = nullptr) {
+    return msgs::create_writer(*participant, *publisher, spec, type, listener);
   }
   void reader(Station& station, const msgs::TopicSpec& spec, dds::TypeSupport type,
               void (*fn)(Station&, dds::DataReader*)) {
@@ -129,8 +132,8 @@ Station::Station(const StationOptions& options) : options_(options), dds_(std::m
   // Every end cap's reports, each from its own partition (msgs/endcap_writers.hpp).
   d.subscriber = d.participant->create_subscriber(msgs::endcap_reports_qos());
   if (d.publisher == nullptr || d.subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
-  d.policy = d.writer(msgs::kPolicyTableTopic, dds::TypeSupport(new msg::PolicyTable_PubSubType()));
-  d.command = d.writer(msgs::kCommandTopic, dds::TypeSupport(new msg::Command_PubSubType()));
+  d.policy = d.writer(msgs::kPolicyTableTopic, dds::TypeSupport(new msg::PolicyTable_PubSubType()), &d.policy_readers);
+  d.command = d.writer(msgs::kCommandTopic, dds::TypeSupport(new msg::Command_PubSubType()), &d.command_readers);
   d.heartbeat = d.writer(msgs::kHostHeartbeatTopic, dds::TypeSupport(new msg::Heartbeat_PubSubType()));
   d.sync_reply = d.writer(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new msg::TimeSyncReply_PubSubType()));
   d.reader(*this, msgs::kPolicyAckTopic, dds::TypeSupport(new msg::PolicyAck_PubSubType()),
@@ -230,21 +233,27 @@ std::uint16_t Station::heard(std::int64_t now_ns, double fresh_s) const {
   return mask;
 }
 
+std::uint16_t Station::reached() const {
+  const Dds& d = *dds_;
+  return static_cast<std::uint16_t>(d.writers.endcaps_of_participants(
+      [&d](const auto& p) { return d.policy_readers.reaches(p) && d.command_readers.reaches(p); }));
+}
+
 bool Station::wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const {
-  std::unique_lock lock(mutex_);
-  auto ready = [&] {
-    for (int i = 0; i < kEndcapCount; ++i) {
+  for (;;) {
+    const std::uint16_t reach = reached();  // its own locks: taken before this station's
+    std::unique_lock lock(mutex_);
+    bool ready = (reach & mask) == mask;
+    for (int i = 0; i < kEndcapCount && ready; ++i) {
       if ((mask & (1U << i)) == 0) continue;
-      if (!status_[i].seen || (synced && !status_[i].heartbeat.clock_synced())) return false;
+      ready = status_[i].seen && (!synced || status_[i].heartbeat.clock_synced());
     }
-    return true;
-  };
-  while (!ready()) {
+    if (ready) return true;
     const std::int64_t wait = deadline_ns - now_ns();
     if (wait <= 0) return false;
-    changed_.wait_for(lock, std::chrono::nanoseconds(std::min<std::int64_t>(wait, 50'000'000)));
+    // Matching is not signalled here: looked at again every 20 ms.
+    changed_.wait_for(lock, std::chrono::nanoseconds(std::min<std::int64_t>(wait, 20'000'000)));
   }
-  return true;
 }
 
 void Station::on_telemetry(std::function<void(const msg::Telemetry_&, std::int64_t)> callback) {

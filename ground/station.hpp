@@ -105,8 +105,11 @@ class Station {
   // hears the host but is not heard can tell and join again.
   std::uint16_t heard(std::int64_t now_ns, double fresh_s) const;
   static constexpr double kHeardFreshS = 2.0;
+  // The end caps (a bit each) whose policy-table and command readers this station's
+  // writers are matched with: what it writes reaches them (msgs/matched_readers.hpp).
+  std::uint16_t reached() const;
   // True once every end cap in `mask` sent a heartbeat (and, with `synced`, says
-  // its clock is synchronized); false at the deadline.
+  // its clock is synchronized) and is reached; false at the deadline.
   bool wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const;
   // Called from the DDS receive thread for every valid telemetry sample, with the
   // host clock at arrival. Set before samples are expected; keep it short.

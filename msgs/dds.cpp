@@ -106,9 +106,9 @@ dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& s
 }
 
 dds::DataWriter* create_writer(dds::DomainParticipant& participant, dds::Publisher& publisher, const TopicSpec& spec,
-                               dds::TypeSupport type) {
+                               dds::TypeSupport type, dds::DataWriterListener* listener) {
   dds::Topic* topic = create_topic(participant, spec, type);
-  dds::DataWriter* writer = publisher.create_datawriter_with_profile(topic, spec.profile);
+  dds::DataWriter* writer = publisher.create_datawriter_with_profile(topic, spec.profile, listener);
   if (writer == nullptr) throw DdsError(std::string("cannot create writer on ") + spec.name);
   return writer;
 }

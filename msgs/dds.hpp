@@ -7,6 +7,7 @@
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -112,7 +113,8 @@ eprosima::fastdds::dds::Topic* create_topic(eprosima::fastdds::dds::DomainPartic
 // Throw DdsError naming the topic.
 eprosima::fastdds::dds::DataWriter* create_writer(eprosima::fastdds::dds::DomainParticipant& participant,
                                                   eprosima::fastdds::dds::Publisher& publisher, const TopicSpec& spec,
-                                                  eprosima::fastdds::dds::TypeSupport type);
+                                                  eprosima::fastdds::dds::TypeSupport type,
+                                                  eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
 eprosima::fastdds::dds::DataReader* create_reader(eprosima::fastdds::dds::DomainParticipant& participant,
                                                   eprosima::fastdds::dds::Subscriber& subscriber, const TopicSpec& spec,
                                                   eprosima::fastdds::dds::TypeSupport type,

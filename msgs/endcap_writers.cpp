@@ -74,4 +74,13 @@ int EndcapWriters::endcap_of(const dds::SampleInfo& info) const {
   return it == endcap_of_writer_.end() ? -1 : it->second;
 }
 
+std::uint32_t EndcapWriters::endcaps_of_participants(const std::function<bool(const rtps::GuidPrefix_t&)>& pick) const {
+  std::lock_guard lock(mutex_);
+  std::uint32_t mask = 0;
+  for (const auto& [guid, endcap] : endcap_of_writer_) {
+    if (endcap >= 0 && pick(guid.guidPrefix)) mask |= 1U << endcap;
+  }
+  return mask;
+}
+
 }  // namespace tensegrity::msgs

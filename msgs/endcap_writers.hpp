@@ -17,6 +17,8 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/qos/SubscriberQos.hpp>
 
+#include <cstdint>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <string>
@@ -49,6 +51,10 @@ class EndcapWriters final : public eprosima::fastdds::dds::DomainParticipantList
   bool vouches(const eprosima::fastdds::dds::SampleInfo& info, int claimed_endcap) const {
     return claimed_endcap >= 0 && endcap_of(info) == claimed_endcap;
   }
+  // The end caps (bit N for end cap N) with a writer from a participant for which
+  // `pick` is true: which end caps a participant-wide fact (a matched reader) holds for.
+  std::uint32_t endcaps_of_participants(
+      const std::function<bool(const eprosima::fastrtps::rtps::GuidPrefix_t&)>& pick) const;
 
  private:
   mutable std::mutex mutex_;
