@@ -189,7 +189,7 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   EXPECT_EQ(no_table, static_cast<std::size_t>(kEndcapCount)) << refused;
 
   // 1. Upload through the program an operator uses.
-  const fs::path policy = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
+  const fs::path policy = fs::path(TENSEGRITY_SOURCE) / "docs" / "results" / "policies" / "superball-t4-n5.json";
   std::string out;
   ASSERT_EQ(
       tensegrity({"upload", policy.string(), "--id", "e2e_gait", "--policy-version", "3", "--timeout", "20"}, out), 0);

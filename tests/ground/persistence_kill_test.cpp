@@ -61,7 +61,8 @@ TEST(PersistenceKill, RebootsWithTheOldOrTheNewTableEachUnderItsOwnIdentity) {
   std::ofstream(dir / "endcap.json") << config.dump(2);
 
   const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
-  const sim::Policy gait = sim::load_policy(fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json", robot);
+  const sim::Policy gait =
+      sim::load_policy(fs::path(TENSEGRITY_SOURCE) / "docs" / "results" / "policies" / "superball-t4-n5.json", robot);
   sim::Policy shifted = gait;
   for (auto& c : shifted.cables) {
     for (double& v : c.rest_lengths_m) v = std::min(v + 0.01, 1.1);

@@ -184,7 +184,7 @@ void a_command_in_the_overlap_is_acked_on_both(Station& station, const EndcapRej
 // A table uploaded while both participants listen reaches both (or, on a link
 // stalled one way, only the old one): it is acked and handed to the loop once.
 void upload_lands_once(Station& station, const EndcapRejoin& t) {
-  const fs::path file = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
+  const fs::path file = fs::path(TENSEGRITY_SOURCE) / "docs" / "results" / "policies" / "superball-t4-n5.json";
   const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(file));
   auto tables =
       policy_messages(sim::load_policy(file, robot), robot,

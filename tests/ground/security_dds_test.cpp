@@ -95,7 +95,7 @@ class SecureDds : public ::testing::Test {
   }
   // The shipped policy's tables for end caps 0-2, as `tensegrity upload` makes them.
   static std::vector<msg::PolicyTable_> tables() {
-    const fs::path file = fs::path(TENSEGRITY_SOURCE) / "policies" / "superball-t4-n5.json";
+    const fs::path file = fs::path(TENSEGRITY_SOURCE) / "docs" / "results" / "policies" / "superball-t4-n5.json";
     const sim::Robot robot = sim::load_robot(sim::robot_path_for_policy(file));
     auto all = policy_messages(sim::load_policy(file, robot), robot,
                                fw::comms::PolicyIdentity{"secured_gait", 7, robot.name, false}, random_sequence_base());

@@ -6,7 +6,7 @@
 set -eu
 cli="$1"
 src="${TENSEGRITY_SOURCE_DIR:?}"
-policy="$src/policies/superball-ntrt2014-t4-n5-e5000.json"
+policy="$src/docs/results/policies/superball-ntrt2014-t4-n5-e5000.json"
 [ -f "$policy" ] || policy=$(ls "$src"/policies/*.json | head -n 1)
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
