@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// The participants whose readers a writer is matched with. A tool that has heard an
-// end cap has matched the end cap's writers, not yet the end cap its own: the two
-// directions of endpoint discovery finish apart, under load by a second or more
-// (Estop.AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt saw an estop from a
-// fresh tool land 1 s late). Until its command reader has matched, every command
-// to that end cap is written to nobody. A station counts an end cap ready when it
-// is heard *and* its readers are matched (Station::wait_for_endcaps).
+// The participants whose readers a writer is matched with. A tool that hears an end
+// cap has matched its readers to the end cap's writers; the end cap may not yet have
+// matched its readers to the tool's writers: the two directions of endpoint discovery
+// finish apart, under load by up to a second (an estop from a fresh tool landed 0.5 s
+// after it was sent in CI and 1.0 s in a loaded reproduction of
+// Estop.AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt). Until the end cap's
+// command reader has matched, every command to it is written to nobody. A station
+// counts an end cap ready when it is heard *and* reached (Station::wait_for_endcaps).
 #pragma once
 
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
