@@ -207,7 +207,11 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   parse_cable_defaults(r, robot);
   parse_cables(r, strut_of, robot);
   parse_ground_and_start(r, robot);
-  robot.hash = fnv1a64_hex(doc.dump());
+  // The hash names the model, not its prose: rewording the description must not
+  // orphan the policies and checkpoints that record the robot they were learned on.
+  json hashed = doc;
+  hashed.erase("description");
+  robot.hash = fnv1a64_hex(hashed.dump());
   return robot;
 }
 

@@ -44,8 +44,8 @@ TEST(Robot, ShippedSuperballLoads) {
   }
 }
 
-// Issue 14: the default is the paper's simulated SUPERball (1.5 m rods, the author's
-// anchors and rod contact, DESIGN.md's cables), not DESIGN.md's 1.7 m hardware.
+// The default is the paper's simulated SUPERball (1.5 m rods, the author's anchors and
+// rod contact, the hardware's cables), not the 1.7 m hardware (docs/design/robot.md).
 TEST(Robot, TheDefaultIsThePapersSimulatedSuperball) {
   const Robot robot = load_robot(default_robot_path());
   EXPECT_EQ(robot.name, "superball-paper");
@@ -64,6 +64,19 @@ TEST(Robot, HashChangesWithContent) {
   doc["cable"]["stiffness_n_per_m"] = 1001.0;
   const Robot b = parse_robot(doc.dump());
   EXPECT_NE(a.hash, b.hash);
+}
+
+// The description is prose for readers; rewording it must not orphan the policies
+// and checkpoints that record the robot's hash.
+TEST(Robot, HashIgnoresTheDescription) {
+  json doc = superball_json();
+  const Robot a = parse_robot(doc.dump());
+  doc["description"] = "reworded";
+  const Robot b = parse_robot(doc.dump());
+  doc.erase("description");
+  const Robot c = parse_robot(doc.dump());
+  EXPECT_EQ(a.hash, b.hash);
+  EXPECT_EQ(a.hash, c.hash);
 }
 
 TEST(Robot, MissingCableEndNamed) {
