@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The summary of `tensegrity analyze`: the numbers docs/results.md sets beside the
+// The summary of `tensegrity analyze`: the numbers docs/reproduction.md sets beside the
 // paper's Figures 10-12, as one JSON object.
 #include <nlohmann/json.hpp>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// `tensegrity bench hil`: the HIL's performance targets (issue #6). Lockstep with
+// `tensegrity bench hil`: the HIL's performance targets (docs/design/hil-performance.md). Lockstep with
 // twelve end-cap programs at 1 kHz at least 5x faster than real time; real time
 // holding 1 kHz with fewer than 0.1% late steps; the CPU each end cap costs.
 //

@@ -200,7 +200,7 @@ void add_hil_command(CLI::App& app) {
       ->check(CLI::Range(0, 232));
   cmd->add_option("--link-attempts", args->link_attempts,
                   "dds: start the run afresh this many times at most when the link does not come up before the "
-                  "start (Fast DDS's stalled secured handshakes; docs/security.md)")
+                  "start (Fast DDS's stalled secured handshakes; docs/guide/security.md)")
       ->check(CLI::Range(1, 10))
       ->capture_default_str();
 #ifdef TENSEGRITY_CLI_DDS

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // `tensegrity view`: a local web page of a recorded run, of the end caps live over
-// DDS, or of an evolution (view/, docs/view.md).
+// DDS, or of an evolution (view/, docs/guide/view.md).
 #include <atomic>
 #include <chrono>
 #include <csignal>

@@ -35,7 +35,7 @@ void check_evolve_launch(bool mpi) {
   if (!launched) {
     throw CommandError(2,
                        "--mpi: not started by mpirun; run e.g. `mpirun -np 4 tensegrity evolve ... --mpi` "
-                       "(docs/evolve.md)");
+                       "(docs/guide/evolve.md)");
   }
 }
 

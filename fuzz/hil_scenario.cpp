@@ -2,7 +2,7 @@
 // libFuzzer target: a HIL fault scenario (hil/scenario.hpp), the same bytes read both
 // as a scenario file (`tensegrity hil --scenario FILE`) and as one `--fault` option.
 // Oracle: only HilError escapes, and every event let through, and then passed by the
-// check against DESIGN.md's robot, is one the fault injector can act on as written.
+// check against the hardware robot (robots/superball.json), is one the fault injector can act on as written.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a policy file ("tensegrity-policy/1") as the simulator reads it
-// (against DESIGN.md's robot, which the corpus's policies are for) and as an end cap reads its share of it.
+// (against the hardware robot, robots/superball.json, which the corpus's policies are
+// for) and as an end cap reads its share of it.
 #include <cstddef>
 #include <cstdint>
 #include <exception>

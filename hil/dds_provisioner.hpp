@@ -17,7 +17,7 @@
 // an emergency stop during the run, every later restart is left idle in both modes,
 // for the rest of the run; starting it again is the operator's. Lockstep decides at
 // the spawn, so an end cap started on boot is stopped by the launcher if the estop
-// is heard just after (dds_provisioner_rejoin.cpp, docs/hil.md).
+// is heard just after (dds_provisioner_rejoin.cpp, docs/guide/hil.md).
 #pragma once
 
 #include <array>
@@ -51,7 +51,7 @@ struct DdsProvisionerConfig {
   std::filesystem::path keystore;
   StepperMode mode = StepperMode::lockstep;
   // Every end cap's heartbeat with a synchronized clock. Usually 1-6 s; a real-time
-  // HIL on 2 cores (1.3 of them at SCHED_FIFO) took up to 14.4 s (docs/hil.md).
+  // HIL on 2 cores (1.3 of them at SCHED_FIFO) took up to 14.4 s (docs/guide/hil.md).
   double discovery_timeout_s = 45.0;
   double upload_timeout_s = 10.0;
   double command_timeout_s = 5.0;

@@ -31,7 +31,7 @@ LinkTiming DdsProvisioner::link_timing() const {
 }
 
 // Fast DDS 2.9's PKI-DH handshake between two processes now and then never
-// completes (docs/security.md: with two secured HIL runs at once, 2 of 8 left one end
+// completes (docs/guide/security.md: with two secured HIL runs at once, 2 of 8 left one end
 // cap unheard for 40 s; alone, 2 of 10 stalled and were recovered by this). A new
 // ground participant (a new GUID) authenticates afresh; so when the set of end caps
 // heard stops growing for kRejoinAfterNs short of all (or all heard but not every

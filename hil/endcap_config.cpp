@@ -10,7 +10,7 @@ namespace tensegrity::hil {
 fw::app::EndcapAppConfig endcap_config(const LauncherConfig& lc, int motors, std::uint16_t port,
                                        const std::filesystem::path& store) {
   fw::app::EndcapAppConfig c;
-  // batch: a cycle's frames in one datagram (docs/udp-can.md, version 2).
+  // batch: a cycle's frames in one datagram (docs/design/udp-can.md, version 2).
   c.bus = "udp:127.0.0.1:" + std::to_string(lc.hub_port) + ",bind=127.0.0.1:" + std::to_string(port) + ",batch";
   c.motor_count = static_cast<std::uint32_t>(motors);
   for (int m = 0; m < motors; ++m)

@@ -3,7 +3,7 @@
 // twelve end-cap programs, boot to the start gate, provisioning (over DDS as on the
 // robot, or locally), an in-phase start, the run, a clean shutdown and a summary
 // with each end cap's table phase. Errors become HilResult::error (the reason),
-// never a hang or an orphan process. docs/hil.md.
+// never a hang or an orphan process. docs/guide/hil.md.
 #pragma once
 
 #include <cstdint>
@@ -58,7 +58,7 @@ struct HilOptions {
   // dds: how many times the whole run is started afresh (every end cap and the ground
   // station new) when the link did not come up before the start. Fast DDS 2.9's
   // secured discovery now and then leaves one end cap unmatched whichever station
-  // joins (docs/security.md, "A stalled handshake"); new participants on both sides
+  // joins (docs/guide/security.md, "A stalled handshake"); new participants on both sides
   // authenticate afresh. Nothing has moved before the start, so a retry is clean.
   int link_attempts = 3;
   std::vector<int> never_start;                               // tests

@@ -30,7 +30,7 @@ enum class FaultKind : std::uint8_t {
   restore_dds,      // ... and restored
   release_spool,    // the spool runs free, the drive does not notice; params: motor
   seize_spool,      // the spool seizes (cable length frozen), the drive does not notice; params: motor
-  // CANopen supervision (docs/canopen.md):
+  // CANopen supervision (docs/design/canopen.md):
   reboot_drive,      // the drive power-cycles: boot-up, pre-operational, unpowered; params: motor
   reboot_load_cell,  // the load cell power-cycles
   hang_loop,         // the end cap's control loop hangs, its process (DDS node) lives (test hook)

@@ -6,7 +6,7 @@
 // for every bus's sensor PDOs and SYNCs and a few recvmmsg for the answers,
 // instead of a poll over twelve sockets and a syscall per frame.
 //
-// Datagram versions (docs/udp-can.md): the hub reads both, and answers an end cap
+// Datagram versions (docs/design/udp-can.md): the hub reads both, and answers an end cap
 // in version 2 (all of a flush's frames to it in one datagram) once that end cap
 // has sent version 2 itself, so an end cap that only knows version 1 still works.
 // One datagram per end cap and tick matters more than the syscall count: every

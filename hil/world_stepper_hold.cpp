@@ -110,7 +110,7 @@ void WorldStepper::serve_until(const std::function<bool()>& done, std::int64_t t
 // arrival at once woke this SCHED_FIFO thread up to twelve times a period and
 // left the end caps' DDS threads too little: a real-time run's DDS bring-up took
 // 2-5 s and its upload 200-650 ms, against 1.2-2.2 s and 40-110 ms served per
-// period (seven alternating runs each, docs/hil-performance.md).
+// period (seven alternating runs each, docs/design/hil-performance.md).
 void WorldStepper::serve_frames_until(std::int64_t until_ns) {
   source_.clock().sleep_until(until_ns, 0);
   for (;;) {

@@ -375,7 +375,7 @@ def main():
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     # A summary only reads: writing --robot's default into the arm would replace the
-    # record of the robot its seeds learned on (it did, in session 17).
+    # record of the robot its seeds learned on (it once did).
     if not args.summary_only:
         robot = write_robot(args, out)
         seeds = range(args.first_seed, args.first_seed + args.seeds)

@@ -5,8 +5,8 @@
 A probe, not a learner the robot uses: CMA-ES (Hansen's (mu/mu_w, lambda) with
 rank-one and rank-mu updates) over the whole table of a policy (24 cables x n
 values), each candidate played by `tensegrity sim --policy` (the same firmware
-core and model the coevolution scores with). It answers one question for
-docs/results.md: is 32 m in 60 s reachable on this model at all, or does the
+core and model the coevolution scores with). It answers one question
+(data: docs/results/ceiling/): is 32 m in 60 s reachable on this model at all, or does the
 coevolution stop below a ceiling of the model's?
 
 Written here with numpy because Debian 12 packages no CMA-ES (no python3-cma);

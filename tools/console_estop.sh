@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # The secured emergency stop through a running `tensegrity console` against one from
 # a fresh tool (`estop --no-console`): 12 end caps (comms_test_node, one process) on
-# loopback, each estop followed by a clear-fault; docs/security.md. Prints and writes
+# loopback, each estop followed by a clear-fault; docs/guide/security.md. Prints and writes
 # OUT/estop.csv (mode, run, exit code, the tool's wall time, the last ack in ms).
 #   tools/console_estop.sh [BUILD=build/default] [RUNS=10] [OUT=out/console-estop] [DOMAIN=190]
 set -u

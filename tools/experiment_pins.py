@@ -2,7 +2,7 @@
 """What every run in an experiments.py output directory must share besides its id: the
 robot, and the evolve settings the program resolved. A run is found again by its
 parameters alone, so a run made on another robot, or by a program whose defaults
-changed (sessions 22 and 23), must not be taken for this one's."""
+changed (population sizes, step schedule), must not be taken for this one's."""
 import json
 import pathlib
 import subprocess
@@ -22,7 +22,7 @@ def pin_robot(a):
 
 
 # What decides a run's result besides its id: `tensegrity evolve`'s defaults for these
-# changed in sessions 22 (sizes) and 23 (step schedule).
+# changed between versions (sizes, then the step schedule).
 SETTINGS = ("population", "replace", "teams", "mutation", "sigma_m", "sigma_final_m", "anneal_start_episodes",
             "anneal_episodes")
 

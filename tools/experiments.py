@@ -73,7 +73,7 @@ def parse_args():
     p.add_argument("--duration", type=float, default=60.0,
                    help="episode length, s (default: the paper's %(default)s; shorter only for smoke tests)")
     p.add_argument("--sigma", type=float, default=None,
-                   help="mutation step, m (default: tensegrity evolve's schedule, docs/evolve.md)")
+                   help="mutation step, m (default: tensegrity evolve's schedule, docs/guide/evolve.md)")
     p.add_argument("--sigma-final", type=float, default=None,
                    help="anneal the step to this, m (default: no annealing once --sigma is given)")
     p.add_argument("--anneal-episodes", type=int, default=0,

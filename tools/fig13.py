@@ -155,7 +155,7 @@ def main():
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--tensegrity", help="the tensegrity program (default: build/release or build/default)")
     # The paper's Figure 13 is about the paper's robot, so the default is the 2014 file's
-    # 5000-episode gait (a record since it skates), not whatever the HIL plays by default. docs/hil.md's figure was made
+    # 5000-episode gait (a record since it skates), not whatever the HIL plays by default. docs/guide/hil.md's figure was made
     # with the 14,000-episode gait kept in docs/results/policies/ (give it as --policy).
     p.add_argument("--policy", default=os.path.join(ROOT, "docs", "results", "policies", "superball-ntrt2014-t4-n5-e5000.json"),
                    help="policy file (default: docs/results/policies/superball-ntrt2014-t4-n5-e5000.json, the paper's robot)")

@@ -43,7 +43,7 @@ def parse_args(argv=None):
     p.add_argument("--set", action="append", default=[], metavar="PATH=JSON", help="change a robot field (repeatable)")
     p.add_argument("--cable", type=int, default=3,
                    help="the cable pulled, 0-based (default: %(default)s, the 13th muscle of the author's NTRT model, "
-                        "mapped onto this file's nodes: docs/model.md)")
+                        "mapped onto this file's nodes: docs/design/model.md)")
     p.add_argument("--rest-length", type=float, default=0.5, help="its rest length, m (default: %(default)s)")
     p.add_argument("--duration", type=float, default=10.0, help="episode length, s (default: %(default)s)")
     p.add_argument("--average-s", type=float, default=1.0,

@@ -3,7 +3,7 @@
 the best team of several seeds' evolutions.
 
 On this model a point's seeds split between a plateau (5-10 m) and rolling modes of
-30-39 m (docs/results.md, "Where issue 14 stands"), so a mean and standard deviation
+30-39 m (docs/reproduction.md), so a mean and standard deviation
 alone would draw a bimodal point as one wide bar. The CSV and the plot give the mean
 with its sd (the paper's kind of error bar), the median and quartiles, the seeds at
 32 m or more, and every seed's own value.

@@ -15,7 +15,7 @@ enum class FaultCause : std::uint8_t {
   host_lost,       // the host link was lost and the end cap is configured to stop
   emergency_stop,  // commanded by an operator
   bad_input,       // the caller broke the step contract (buffer sizes)
-  // CANopen supervision (docs/canopen.md "Supervision"):
+  // CANopen supervision (docs/design/canopen.md "Supervision"):
   node_rebooted,   // a drive or the load cell sent a boot-up after bring-up
   drive_disabled,  // a drive left operation enabled without being asked
   stale_position,  // no drive position newer than the configured age

@@ -12,7 +12,7 @@ inline constexpr std::size_t kMaxComplexity = 16;
 
 // What a motor does while its cable is above the cut-off tension.
 enum class Overload : std::uint8_t {
-  hold,     // stop shortening, keep the length (DESIGN.md's guard)
+  hold,     // stop shortening, keep the length (the hardware guard, docs/design/robot.md)
   pay_out,  // give cable at the motor speed until the tension is back under the cut-off: the
             // paper's back-driven motor that feeds out cable (Iscen et al., section 3), and
             // NTRT's muscle, whose moveMotors raises the preferred length to keep k (L - L0)

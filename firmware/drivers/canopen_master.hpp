@@ -47,7 +47,7 @@ struct CanopenMasterConfig {
   std::int64_t sdo_timeout_ns = 50'000'000;
   std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
   std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
-  // Supervision the other way (docs/canopen.md "Supervision"): the end cap's own
+  // Supervision the other way (docs/design/canopen.md "Supervision"): the end cap's own
   // node id and heartbeat (its 0x1017; 0: none), which every drive is told to
   // watch in bring-up (0x1016 sub 1, consumer time; 0: not configured) with the
   // abort-connection option (0x6007) it takes by itself when the end cap falls silent.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Our fixed PDO mappings and SYNC, as pure encode/decode functions, used by the
-// master and by emulated devices (tests, HIL). Table: docs/canopen.md.
+// master and by emulated devices (tests, HIL). Table: docs/design/canopen.md.
 //
 //   drive RPDO1 0x200+id  6 bytes  controlword u16 | target position i32 (counts)
 //   drive TPDO1 0x180+id  6 bytes  statusword u16  | actual position i32 (counts)

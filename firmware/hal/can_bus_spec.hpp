@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Text form of a CAN bus choice, as given on a command line or in a config file:
 //   udp:HOST:PORT[,bind=HOST:PORT][,batch]
-//                                    frames over UDP to HOST:PORT (docs/udp-can.md);
+//                                    frames over UDP to HOST:PORT (docs/design/udp-can.md);
 //                                    bind defaults to 0.0.0.0:0 (any port); batch:
 //                                    send a cycle's frames as one version-2 datagram
 //   socketcan:IFNAME                 a Linux CAN interface, e.g. can0 or vcan0

@@ -19,7 +19,7 @@
 // header drops the whole datagram; a bad record drops that record only, as a bad
 // frame on a CAN bus would. Version 1 (udp_can_wire.hpp) stays valid: a receiver
 // reads both (DatagramReader), a sender uses version 2 only when told its peer
-// reads it. Full description: docs/udp-can.md. Pure code, no OS headers.
+// reads it. Full description: docs/design/udp-can.md. Pure code, no OS headers.
 #pragma once
 
 #include <array>

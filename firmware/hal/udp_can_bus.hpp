@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // CanBus over UDP, for kernels without AF_CAN and for the HIL emulator. Wire format:
 // udp_can_wire.hpp (version 1, one frame a datagram), udp_can_batch.hpp (version 2,
-// several) and docs/udp-can.md. The socket is unconnected: frames are sent to the
+// several) and docs/design/udp-can.md. The socket is unconnected: frames are sent to the
 // configured remote and accepted from any sender, so an emulator may answer from
 // whichever socket it likes. Both versions are always read; with `batch` the frames
 // send() is given wait for flush() (the control loop's end of cycle) and go out as

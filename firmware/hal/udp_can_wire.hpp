@@ -13,7 +13,7 @@
 //
 // A datagram of any other size, magic or version, with unknown flag bits, a
 // nonzero reserved byte, dlc > 8 or an id out of range is dropped and counted,
-// never passed on. Full description: docs/udp-can.md. Pure code, no OS headers,
+// never passed on. Full description: docs/design/udp-can.md. Pure code, no OS headers,
 // so the HIL emulator can reuse it.
 #pragma once
 

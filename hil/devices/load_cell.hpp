@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// An emulated two-channel load cell (CiA 404-like, TPDO1 in docs/canopen.md).
+// An emulated two-channel load cell (CiA 404-like, TPDO1 in docs/design/canopen.md).
 // Unit tests script `sample` directly and let it answer SYNC; the HIL emulator
 // feeds the model's tensions (set_tensions_n) and emits the TPDO before SYNC
 // (emit_tpdo). Faults: a stuck sensor (value and sequence frozen: the master

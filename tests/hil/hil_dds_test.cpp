@@ -75,7 +75,7 @@ TEST(HilDds, AnEndCapMissingFromTheLinkIsNamed) {
 }
 
 // Fast DDS 2.9's secured discovery now and then leaves one end cap unmatched whichever
-// ground station joins (docs/security.md); the run then starts every process afresh.
+// ground station joins (docs/guide/security.md); the run then starts every process afresh.
 // Here end cap 7 stays off DDS in the first attempt only.
 TEST(HilDds, ALinkThatDoesNotComeUpStartsTheRunAfresh) {
   HilOptions o = options(1.0, Provision::dds);

@@ -64,7 +64,7 @@ TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
     EXPECT_EQ(e.exit_status, 0) << "end cap " << e.endcap << " did not shut down cleanly";
     // Not asserted: at full lockstep speed the emulator and the loops (real-time
     // priority) can starve the DDS threads on a loaded 2-core host long enough for
-    // an end cap to call its host lost (docs/hil.md); the gait is open loop.
+    // an end cap to call its host lost (docs/guide/hil.md); the gait is open loop.
     if (e.host_losses > 0)
       std::printf("end cap %d reported %llu host loss(es)\n", e.endcap, static_cast<unsigned long long>(e.host_losses));
   }

@@ -43,7 +43,7 @@ TEST(EndcapWriters, AnUnknownWriterVouchesForNobody) {
 }
 
 // A writer discovered in end cap 1's partition that later announces end cap 2's
-// (a QoS update; docs/security.md "A writer that moves") vouches for nobody again.
+// (a QoS update; docs/guide/security.md "A writer that moves") vouches for nobody again.
 TEST(EndcapWriters, AWriterThatChangesPartitionVouchesForNobodyFromThenOn) {
   namespace rtps = eprosima::fastrtps::rtps;
   EndcapWriters writers;

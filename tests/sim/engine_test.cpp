@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The Bullet engine against the ODE one: the same robot must stand, keep its energy
 // and collide in both, so that a difference in learning is the engines' contacts
-// and integration, not a broken model. And the zeroed axial spin of issue 14's
+// and integration, not a broken model. And the zeroed axial spin of the NTRT
 // Bullet cross-check, in both engines.
 #include <gtest/gtest.h>
 
@@ -53,7 +53,7 @@ TEST(BulletEngine, StandsOnThreeEndCapsWithOdesTensions) {
   EXPECT_LT((model.centre_m() - start).norm(), 0.01) << "the settled robot drifted";
   // Bullet's resting contacts do not hold the tripod quite still: it turns in place
   // at about 0.03 rad/s (6 mJ), with or without spin, gyroscopic term, 50 solver
-  // iterations or two friction directions (docs/model.md, "Engines"). The centre stays.
+  // iterations or two friction directions (docs/design/model.md, "Engines"). The centre stays.
   EXPECT_LT(model.kinetic_energy_j(), 0.02);
   EXPECT_EQ(std::popcount(model.ground_contact_mask()), 3) << "not on a triangle of end caps";
   EXPECT_GE(model.contact_count(), 3);

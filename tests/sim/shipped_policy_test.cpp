@@ -36,7 +36,7 @@ TEST(ShippedPolicies, EachLoadsWithItsRobotAndRollsTheDistanceItWasScoredWith) {
     const Policy policy = load_policy(entry.path(), robot);
     EXPECT_EQ(policy.provenance.robot_hash, robot.hash)
         << entry.path() << ": made for another version of " << robot.name;
-    // Issue 14: every shipped policy learned from scratch by the coevolution, within
+    // Every shipped policy learned from scratch by the coevolution, within
     // the paper's 5000 episodes, with its seed recorded.
     EXPECT_GT(policy.provenance.episodes, 0) << entry.path();
     EXPECT_LE(policy.provenance.episodes, 5000) << entry.path();
@@ -56,7 +56,7 @@ TEST(ShippedPolicies, EachLoadsWithItsRobotAndRollsTheDistanceItWasScoredWith) {
 }
 
 // The main job's gait (scripts/run.sh, `tensegrity hil` by default) is the default
-// robot's, held to what issue 14 asks of a shipped policy: learned from scratch within
+// robot's, held to what a shipped policy must do: learned from scratch within
 // the paper's 5000 episodes, at least the paper's 32 m, rolling on all 12 end caps, not
 // skating on spinning struts, and clear of the firmware's tension cut-off.
 TEST(ShippedPolicies, TheMainJobsGaitIsTheDefaultRobotsAndRollsAsTheIssueAsks) {
@@ -90,7 +90,7 @@ TEST(ShippedPolicies, TheMainJobsGaitIsTheDefaultRobotsAndRollsAsTheIssueAsks) {
   EXPECT_LT(r.max_tension_n, 0.9 * robot.motor.cutoff_tension_n);
 }
 
-// The spin-held robot's gait (the main job's from session 23 to 28) learned with the
+// The spin-held robot's gait learned with the
 // same defaults holds its struts' spin exactly.
 TEST(ShippedPolicies, TheSpinHeldRobotsGaitHoldsItsStrutsSpin) {
   const fs::path file = policies_dir() / "superball-spin-held-t4-n5.json";

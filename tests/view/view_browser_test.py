@@ -5,7 +5,7 @@ mode loads, draws (pixels read back), holds 12 end caps and 24 cables; the repla
 slider moves time and the robot; the live page follows a HIL run (real time: see test_live), says
 "disconnected" when its server stops and reconnects when it is back; the view
 refuses every method but GET. Prints the replay's open time and frame rate and the
-live latency (measured here, not asserted: docs/view.md)."""
+live latency (measured here, not asserted: docs/guide/view.md)."""
 import argparse
 import json
 import os
@@ -106,13 +106,13 @@ def test_live(args, driver, tmp):
     hil_log = os.path.join(tmp, "hil.log")
     # A lockstep run, as the issue asks, at real-time speed (`hil --view` sets
     # --speed 1): flat out, its SCHED_FIFO threads held both cores and the page's
-    # scripts timed out; in real time (sessions 9-10) twelve end caps' own 1 kHz
+    # scripts timed out; in real time twelve end caps' own 1 kHz
     # loops left their DDS threads so little that discovery or time sync missed
     # 30 s in CI. The page opens once all 12 end caps play (--view-wait 0, then the
     # view's own status), so that the software-rendering browser does not compete
     # with the run's DDS discovery.
     # --insecure: the page's own DDS participant does not rejoin a stalled DDS
-    # Security handshake yet (docs/security.md); what is tested here is the page.
+    # Security handshake yet (docs/guide/security.md); what is tested here is the page.
     with Process([args.tensegrity, "hil", "--insecure", "--mode", args.hil_mode, "--duration", "300", "--endcap", args.endcap,
                   "--barrier-timeout", "30", "--view", "--view-port", str(port), "--view-wait", "0"], hil_log) as hil:
         domain, _ = wait_for("hil --view's page", lambda: hil_domain(hil_log), 60)

@@ -48,7 +48,7 @@ TEST(EndcapConfig, ParsesAFullConfig) {
   EXPECT_EQ(c.mode, LoopMode::lockstep);
   EXPECT_EQ(c.period_ns(), 2'000'000);
   EXPECT_DOUBLE_EQ(c.limits.hard_limit_tension_n, 500.0);
-  EXPECT_EQ(c.limits.overload, core::Overload::hold) << "absent: DESIGN.md's guard";
+  EXPECT_EQ(c.limits.overload, core::Overload::hold) << "absent: the hardware guard";
   EXPECT_FALSE(c.start_on_boot);
 }
 

@@ -82,7 +82,7 @@ class RawPeer {
 };
 
 TEST(UdpCanBatch, ByteLayoutIsAsDocumented) {
-  // docs/udp-can.md's example: drive 3's RPDO1 (controlword 0x000F, target 1000), SYNC.
+  // docs/design/udp-can.md's example: drive 3's RPDO1 (controlword 0x000F, target 1000), SYNC.
   CanFrame rpdo = make_frame(0x203, 6, 0);
   rpdo.data = {0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00, 0xAA, 0xAA};  // bytes past dlc are not sent
   CanFrame sync;

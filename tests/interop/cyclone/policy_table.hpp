@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // A policy table for one end cap in Cyclone's C type, with the checksum computed
-// from docs/dds.md "Policy checksum" (written again here on purpose: an end cap
+// from docs/design/dds.md "Policy checksum" (written again here on purpose: an end cap
 // accepting it shows the documented encoding is the one the firmware checks).
 #pragma once
 

@@ -63,7 +63,7 @@ if "$tensegrity" evolve "${small[@]}" --mutation gaussian --sigma 0.015 --episod
   fail "a resume under another operator was accepted"
 fi
 grep -q 'mutation: "author" -> "gaussian"' "$work/out" || fail "the refusal does not name the operator: $(cat "$work/out")"
-# Without --population and --replace: 40 members, 20 replaced (docs/evolve.md), and a
+# Without --population and --replace: 40 members, 20 replaced (docs/guide/evolve.md), and a
 # run begun with the author's 10 and 5 is not silently continued under them.
 "$tensegrity" evolve --period 1 --complexity 2 --teams 4 --seed 3 --threads 1 --duration 0.5 --episodes 4 \
   --out "$work/d.json" --log "$work/d.csv" --json > "$work/dsummary.json"
@@ -82,7 +82,7 @@ if "$tensegrity" evolve --period 1 --complexity 2 --teams 4 --seed 3 --threads 1
 fi
 grep -q "population: 10 -> 40" "$work/out" || fail "the refusal does not name the population: $(cat "$work/out")"
 # Without a step option the Gaussian operator anneals 0.05 m to 0.02 m over episodes
-# 2000-5000 (docs/evolve.md); one step option makes the schedule the user's: constant.
+# 2000-5000 (docs/guide/evolve.md); one step option makes the schedule the user's: constant.
 /usr/bin/python3 - "$work" <<'PY' || fail "the default step schedule is not 0.05 -> 0.02 over 2000-5000"
 import json, sys
 c = json.load(open(f"{sys.argv[1]}/dsummary.json"))["config"]
