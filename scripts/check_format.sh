@@ -5,7 +5,9 @@
 # them in place instead.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.h')
+# git's tracked files, or the files on disk where there is no git (scripts/source_files.py)
+mapfile -t files < <(/usr/bin/python3 scripts/source_files.py '*.cpp' '*.hpp' '*.h')
+(( ${#files[@]} > 0 )) || { echo "format: no C++ files found" >&2; exit 1; }
 if [[ "${1:-}" == "--fix" ]]; then
   clang-format -i "${files[@]}"
   exit 0

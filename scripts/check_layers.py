@@ -22,9 +22,10 @@ import argparse
 import json
 import os
 import re
-import subprocess
 import sys
 import tempfile
+
+import source_files
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SOURCE = re.compile(r"\.(cpp|cc|hpp|h|inc)$")
@@ -108,8 +109,7 @@ def check_tree(root, rules_path, files):
 
 
 def tracked_files(root):
-    out = subprocess.run(["git", "ls-files"], cwd=root, capture_output=True, text=True, check=True).stdout
-    return out.split()
+    return source_files.files(root)
 
 
 def self_test():
@@ -153,10 +153,11 @@ def main():
     args = p.parse_args()
     if args.self_test and not self_test():
         return 1
-    problems = check_tree(ROOT, args.rules, tracked_files(ROOT))
+    tracked = tracked_files(ROOT)
+    problems = check_tree(ROOT, args.rules, tracked)
     for line in problems:
         print(line)
-    files = sum(1 for f in tracked_files(ROOT) if SOURCE.search(f))
+    files = sum(1 for f in tracked if SOURCE.search(f))
     if problems:
         print(f"layers: {len(problems)} violation(s) of scripts/layers.json")
         return 1

@@ -23,6 +23,8 @@ import subprocess
 import sys
 import tempfile
 
+import source_files
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 80
@@ -33,8 +35,7 @@ WARNING = re.compile(r"^(.*?):(\d+):\d+: warning: function '([^']*)' exceeds rec
 
 
 def sources():
-    out = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
-    return [f for f in out.split() if SOURCE.search(f) and not f.startswith("tests/")]
+    return [f for f in source_files.files(ROOT) if SOURCE.search(f) and not f.startswith("tests/")]
 
 
 def read_exceptions(path):

@@ -17,10 +17,10 @@ scripts/check_format.sh
 cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" -j "$(nproc)"
 # No source file over 400 lines, no function over 80 (scripts/size-exceptions.txt).
-python3 scripts/check_size.py -p "build/$preset" --self-test
+/usr/bin/python3 scripts/check_size.py -p "build/$preset" --self-test
 # Which room may include which (scripts/layers.json: each room includes only the
 # rooms its target links; firmware/core the C++ standard library only).
-python3 scripts/check_layers.py --self-test
+/usr/bin/python3 scripts/check_layers.py --self-test
 # A host build without DDS (TENSEGRITY_WITH_DDS=OFF: no msgs, node, ground tools or
 # view) must configure, and its `endcap` program (the firmware for a board without
 # the Wi-Fi link: tables from --policy and storage) must build: about 2 minutes; the
