@@ -117,10 +117,14 @@ void add_command(CLI::App& app, const std::string& name, const std::string& help
   cmd->add_flag("--no-console", args->no_console, "Speak on this tool's own DDS participant even if a console runs")
       ->excludes(console);
   cmd->callback([args, name, kind] {
+    // The operator asks now; this tool's participant hears the end caps seconds later,
+    // and an estop another tool lands meanwhile must not be cleared (docs: clear-fault).
+    const auto asked = std::make_shared<ground::EstopsSeen>(ground::estops_asked_now());
     if (through_console(name, *args, kind)) return;
     const ground::StationOptions station_opts = station_options(args->ground);
     auto station = std::make_unique<ground::Station>(station_opts);
     ground::CommandOptions options;
+    if (kind == ground::CommandKind::clear_fault) options.estops_seen = asked;
     options.endcap_mask = parse_endcap_set(args->ground.endcaps);
     options.timeout_s = args->ground.timeout_s;
     // The estop is re-sent every kEstopRetryIntervalS to whoever has not acked.

@@ -95,13 +95,14 @@ def policy_table(endcap, values, motors=2, complexity=5, version=1, force=False,
     return c.payload()
 
 
-def command(kind, seq=1, mask=0xFFF, start=0, issued=1_000_000_000):
+def command(kind, seq=1, mask=0xFFF, start=0, issued=1_000_000_000, asked=900_000_000):
     c = Cdr()
     c.u16(format_version()); c.u32(seq); c.u8(kind); c.u16(mask); c.i64(start); c.i64(issued)
     for e in range(12):
         c.u32(0x5eed0000 + e if kind == 3 else 0)  # lives_seen: a clear-fault names what it saw
     for e in range(12):
         c.u32(e % 3 if kind == 3 else 0)  # estops_seen
+    c.i64(asked if kind == 3 else 0)  # asked_host_time_ns: when the operator asked
     return c.payload()
 
 

@@ -31,11 +31,18 @@ void EstopsSeen::write_to(msg::Command_& cmd) const {
   }
   cmd.lives_seen(lives);
   cmd.estops_seen(counts);
+  cmd.asked_host_time_ns(asked_host_time_ns);
 }
 
 EstopsSeen estops_seen_now(const Station& station, std::uint16_t mask) {
-  EstopsSeen seen;
+  EstopsSeen seen = estops_asked_now();
   seen.take_heard(station, mask);
+  return seen;
+}
+
+EstopsSeen estops_asked_now() {
+  EstopsSeen seen;
+  seen.asked_host_time_ns = Station::now_ns();
   return seen;
 }
 

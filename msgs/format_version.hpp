@@ -15,6 +15,7 @@ namespace tensegrity::msgs {
 // 4: a clear-fault names the emergency stops it has seen (estops_seen); heartbeats
 //    and command acks carry the end cap's count (estops_received).
 // 5: and the end cap's life (lives_seen; life_id).
-inline constexpr std::uint16_t kFormatVersion = 5;
+// 6: a clear-fault says when the operator asked (asked_host_time_ns).
+inline constexpr std::uint16_t kFormatVersion = 6;
 
 }  // namespace tensegrity::msgs

@@ -61,15 +61,26 @@ GateDecision CommandGate::judge(const CommandSample& c, const HostClockView& clo
       return d;
     }
   }
-  if (d.kind == WireCommandKind::clear_fault && c.estops_seen != estops_taken) {
-    d.reason = CommandReason::estop_unseen;
-    return d;
+  if (d.kind == WireCommandKind::clear_fault) {
+    if (!valid_wire_time(c.asked_host_time_ns)) {
+      d.reason = CommandReason::bad_time;
+      return d;
+    }
+    if (c.estops_seen != estops_taken || newest_estop_issued_ns_ > c.asked_host_time_ns) {
+      d.reason = CommandReason::estop_unseen;
+      return d;
+    }
   }
   d.verdict = GateVerdict::deliver;
   return d;
 }
 
 void CommandGate::record(const CommandSample& c, CommandReason reason) {
+  const bool estop = c.kind == static_cast<std::uint8_t>(WireCommandKind::emergency_stop);
+  if (estop && reason == CommandReason::accepted && c.format_version == format_version_ &&
+      valid_wire_time(c.issued_host_time_ns) && c.issued_host_time_ns > newest_estop_issued_ns_) {
+    newest_estop_issued_ns_ = c.issued_host_time_ns;
+  }
   answers_[next_answer_] = Answer{c.writer, c.seq, reason, true};
   next_answer_ = (next_answer_ + 1) % kRemembered;
   if (reason == CommandReason::out_of_order) return;

@@ -20,7 +20,13 @@
 //    cap take (its life id and count); when the end cap has taken another since, or
 //    it is another life, the clear is refused (estop_unseen). Ordering (rule 5) is
 //    per writer, so without this a clear-fault from one tool, delayed on the link,
-//    could land after another tool's emergency stop and undo it.
+//    could land after another tool's emergency stop and undo it. It also says when
+//    the operator asked (host clock; bad_time if it is not a valid time): an end cap
+//    that took an emergency stop issued after that refuses it too (estop_unseen), so
+//    a tool that first heard this end cap after such a stop, and so names the count
+//    with it, cannot undo it. Both times are the host's CLOCK_MONOTONIC, the clock
+//    every ground tool on the host shares; an estop of another format version says
+//    nothing of its time.
 //
 // History: the end cap's command reader is VOLATILE, so a fresh end cap is never
 // handed the samples a writer kept from before it matched (msgs/qos_profiles.xml,
@@ -48,7 +54,8 @@ struct CommandSample {
   std::uint16_t endcap_mask = 0;
   std::int64_t start_host_time_ns = 0;
   std::int64_t issued_host_time_ns = 0;
-  EstopCount estops_seen;  // this end cap's entries of Command_::lives_seen / estops_seen
+  EstopCount estops_seen;               // this end cap's entries of Command_::lives_seen / estops_seen
+  std::int64_t asked_host_time_ns = 0;  // clear-fault: when the operator asked (host clock)
 };
 
 enum class GateVerdict : std::uint8_t {
@@ -82,7 +89,8 @@ class CommandGate {
   // gate: call record() with the final answer.
   GateDecision judge(const CommandSample& c, const HostClockView& clock, const EstopCount& estops_taken) const;
   // Remembers the answer given to `c` (rule 2) and its seq as its writer's newest
-  // (rule 5) when it was acted on or refused for what it said (not for ordering).
+  // (rule 5) when it was acted on or refused for what it said (not for ordering);
+  // an emergency stop's issue time (rule 7).
   void record(const CommandSample& c, CommandReason reason);
 
  private:
@@ -108,6 +116,7 @@ class CommandGate {
   std::size_t next_answer_ = 0;
   std::array<WriterState, kWriters> writers_{};
   std::uint64_t uses_ = 0;
+  std::int64_t newest_estop_issued_ns_ = -1;  // host clock; -1: none with a known time
 };
 
 // Serial-number order of 32-bit sequence numbers (RFC 1982): a is newer than b.

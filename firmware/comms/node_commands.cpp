@@ -35,6 +35,7 @@ CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info, int
     c.estops_seen.life_id = cmd.lives_seen()[static_cast<std::size_t>(endcap_id)];
     c.estops_seen.count = cmd.estops_seen()[static_cast<std::size_t>(endcap_id)];
   }
+  c.asked_host_time_ns = cmd.asked_host_time_ns();
   return c;
 }
 

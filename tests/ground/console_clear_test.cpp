@@ -3,7 +3,7 @@
 // operator had not seen when asking: one queued behind another command names the
 // estop counts of its asking, and `tensegrity clear-fault` whose relayed clear an
 // estop preempted does not send it again from its own participant (which would name
-// the counts after that estop). End caps 0-2 (comms_test_node), domains 188-189.
+// the counts after that estop). End caps 0-2 (comms_test_node), domains 188-189 and 193.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -83,6 +83,39 @@ TEST_F(ConsoleLink, AClearQueuedBehindAStopDoesNotUndoAnEstopThatLandedMeanwhile
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_TRUE(all_estopped(*station, 0b111)) << "the queued clear undid the estop";
+}
+
+// A clear-fault asked before its tool heard any end cap (a fresh `tensegrity
+// clear-fault --no-console` joining the domain) while another tool's estop lands
+// meanwhile: the end caps it hears afterwards report the count with that estop in
+// it, yet the estop came after the asking, so every end cap refuses the clear.
+TEST_F(ConsoleLink, AClearAskedBeforeItsToolHeardTheEndcapsDoesNotUndoAnEstopLandedMeanwhile) {
+  constexpr int kDomain = 193;
+  const std::shared_ptr<Station> station = three_endcaps(kDomain);
+  ASSERT_TRUE(station) << "end caps 0-2 or the station did not come up";
+  auto asked = std::make_shared<EstopsSeen>(estops_asked_now());  // nothing heard yet
+  const CommandReport stopped = estop(*station);                  // the console's estop
+  ASSERT_TRUE(stopped.all_accepted()) << format_command_report(stopped);
+  ASSERT_TRUE(wait_estopped(*station, 0b111));
+  const std::unique_ptr<Station> late = another_tool(kDomain);  // hears each count with the estop in it
+  ASSERT_TRUE(late) << "the late tool hears no end cap";
+  CommandOptions co;
+  co.endcap_mask = 0b111;
+  co.timeout_s = 10.0;
+  co.estops_seen = asked;
+  const CommandReport cleared = send_command(*late, CommandKind::clear_fault, 0, co);
+  ASSERT_EQ(cleared.results.size(), 3U) << format_command_report(cleared);
+  for (const auto& r : cleared.results) {
+    EXPECT_TRUE(r.acked) << "end cap " << r.endcap;
+    EXPECT_EQ(r.reason, CommandReason::estop_unseen) << "end cap " << r.endcap << ": " << r.text;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_TRUE(all_estopped(*station, 0b111)) << "the stale clear undid the estop";
+
+  // Asked now, after the estop: it clears.
+  co.estops_seen = std::make_shared<EstopsSeen>(estops_asked_now());
+  const CommandReport fresh = send_command(*late, CommandKind::clear_fault, 0, co);
+  EXPECT_TRUE(fresh.all_accepted()) << format_command_report(fresh);
 }
 
 // `tensegrity clear-fault` finds the console on its default socket; the console's

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "firmware/comms/wire_time.hpp"
 
 namespace tensegrity::fw::comms {
@@ -27,6 +29,7 @@ CommandSample command(WireCommandKind kind, std::uint32_t seq, std::uint8_t writ
   c.endcap_mask = 0x0FFF;
   c.start_host_time_ns = 10'000'000'000;
   c.issued_host_time_ns = 9'000'000'000;
+  c.asked_host_time_ns = 9'000'000'000;  // read for a clear-fault only
   return c;
 }
 
@@ -178,6 +181,56 @@ TEST(CommandGate, AClearFaultThatSawAnEarlierLifeNeverMatches) {
   // A tool that never heard the end cap names no life: refused, estops taken or not.
   clear.estops_seen = {};
   EXPECT_EQ(gate.judge(clear, kSynced, {0x5eed0003, 0}).reason, CommandReason::estop_unseen);
+}
+
+// Rule 7's time: a tool that first heard this end cap after another tool's estop
+// names the count with that estop in it; the estop was issued after the operator
+// asked, so the clear is refused all the same.
+TEST(CommandGate, AClearAskedBeforeAnEstopWasIssuedIsRefusedEvenWithItsCount) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  constexpr std::uint32_t kLife = 0x5eed0001;
+  CommandSample estop = command(WireCommandKind::emergency_stop, 7, 2);
+  estop.issued_host_time_ns = 9'200'000'000;
+  handle(gate, estop);
+  CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
+  clear.estops_seen = {kLife, 1};
+  clear.asked_host_time_ns = 9'100'000'000;
+  EXPECT_EQ(gate.judge(clear, kSynced, {kLife, 1}).reason, CommandReason::estop_unseen);
+  clear.asked_host_time_ns = 9'200'000'000;  // asked as the estop went out: it could have seen it
+  EXPECT_EQ(gate.judge(clear, kSynced, {kLife, 1}).verdict, GateVerdict::deliver);
+  // A re-sent estop (the same sample) keeps its first time; a later one moves it on.
+  handle(gate, estop);
+  CommandSample later = command(WireCommandKind::emergency_stop, 8, 2);
+  later.issued_host_time_ns = 9'400'000'000;
+  handle(gate, later);
+  clear.asked_host_time_ns = 9'300'000'000;
+  EXPECT_EQ(gate.judge(clear, kSynced, {kLife, 2}).reason, CommandReason::estop_unseen);
+}
+
+TEST(CommandGate, AClearWithoutAValidAskedTimeIsRefused) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
+  for (const std::int64_t bad : {std::int64_t{-1}, kMaxWireTimeNs + 1, std::numeric_limits<std::int64_t>::min()}) {
+    clear.asked_host_time_ns = bad;
+    EXPECT_EQ(gate.judge(clear, kSynced, kNoEstops).reason, CommandReason::bad_time) << bad;
+  }
+}
+
+// An estop is taken whatever its version or time, but only one of this version with
+// a valid time says when it was issued: a foreign one must not refuse every clear
+// for the rest of the end cap's life.
+TEST(CommandGate, OnlyAnEstopOfThisVersionWithAValidTimeDatesTheStops) {
+  CommandGate gate(0, kVersion, kMaxAge);
+  CommandSample foreign = command(WireCommandKind::emergency_stop, 7, 2);
+  foreign.format_version = kVersion + 1;
+  foreign.issued_host_time_ns = 9'900'000'000;
+  EXPECT_EQ(handle(gate, foreign).verdict, GateVerdict::deliver);
+  CommandSample bad_time = command(WireCommandKind::emergency_stop, 8, 2);
+  bad_time.issued_host_time_ns = -5;
+  EXPECT_EQ(handle(gate, bad_time).verdict, GateVerdict::deliver);
+  CommandSample clear = command(WireCommandKind::clear_fault, 20, 1);
+  clear.asked_host_time_ns = 9'100'000'000;
+  EXPECT_EQ(gate.judge(clear, kSynced, kNoEstops).verdict, GateVerdict::deliver);
 }
 
 TEST(CommandGate, OnlyAClearFaultIsJudgedByTheEstopsItHasSeen) {
