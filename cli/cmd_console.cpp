@@ -47,14 +47,19 @@ class KeyCommands {
     auto done = std::make_shared<std::atomic<bool>>(false);
     workers_.push_back({std::jthread([this, kind, mask, timeout_s, estop, done] {
                           std::string text;
+                          std::string unsure;  // an estop that may not have reached every end cap
                           try {
-                            text = ground::format_command_report(server_.run({kind, mask, timeout_s}));
+                            const ground::CommandReport report = server_.run({kind, mask, timeout_s});
+                            text = ground::format_command_report(report);
+                            if (estop && !report.preempted && !report.missing().empty()) unsure = "no ack from some";
                           } catch (const std::exception& e) {
                             text = std::string("not sent: ") + e.what() + "\n";
+                            if (estop) unsure = e.what();
                           }
                           if (estop) estop_pending_ = false;
                           std::lock_guard lock(mutex_);
                           last_ = std::string("last command: ") + ground::to_string(kind) + "\n" + text;
+                          if (estop) estop_unsure_ = unsure;
                           ++reports_;
                           *done = true;
                         }),
@@ -63,6 +68,14 @@ class KeyCommands {
   std::pair<std::string, int> last() const {
     std::lock_guard lock(mutex_);
     return {last_, reports_};
+  }
+  bool estop_pending() const { return estop_pending_.load(); }
+  // Waits for every command in flight (the server ends all but estops at shutdown).
+  void finish() { workers_.clear(); }
+  // Why the latest estop may not have landed everywhere; empty when all acked.
+  std::string estop_unsure() const {
+    std::lock_guard lock(mutex_);
+    return estop_unsure_;
   }
 
  private:
@@ -74,6 +87,7 @@ class KeyCommands {
   std::atomic<bool> estop_pending_{false};
   mutable std::mutex mutex_;
   std::string last_;
+  std::string estop_unsure_;
   int reports_ = 0;
   std::vector<Worker> workers_;  // touched by the key loop only
 };
@@ -148,7 +162,17 @@ void run_console(const ConsoleArgs& args) {
     shown_reports = reports;
     std::fflush(stdout);
   }
-  server->shutdown();  // commands in flight end now, so the key workers can be joined
+  // A stop or clear in flight ends now; an emergency stop runs to its end first, and
+  // its report is the console's last word (quitting must never drop a stop).
+  server->shutdown();
+  if (commands.estop_pending()) std::fprintf(stderr, "console: quitting once the emergency stop in flight is done\n");
+  commands.finish();
+  const auto [last, reports] = commands.last();
+  if (reports != shown_reports) std::printf("%s", last.c_str());
+  std::fflush(stdout);
+  if (const std::string unsure = commands.estop_unsure(); !unsure.empty()) {
+    throw CommandError(1, "console: the last emergency stop did not reach every end cap (" + unsure + ")");
+  }
 }
 
 }  // namespace

@@ -81,14 +81,15 @@ CommandReport OperatorServer::run(const OperatorRequest& request) {
   if (estop) ++estops_waiting_;
   std::unique_lock lock(command_mutex_);
   if (estop) --estops_waiting_;
-  if (stopping_) throw OperatorLinkError("the console is stopping");
+  if (stopping_ && !estop) throw OperatorLinkError("the console is stopping");
   CommandOptions options;
   options.endcap_mask = request.endcap_mask;
   options.timeout_s = request.timeout_s;
   options.estops_seen = seen;
   // Any command in flight, an older estop included, yields to a newer estop; the
-  // end caps an estop had not yet heard from pass to the one that took over.
-  options.keep_going = [this] { return estops_waiting_.load() == 0 && !stopping_.load(); };
+  // end caps an estop had not yet heard from pass to the one that took over. The
+  // console stopping ends the others, never an estop.
+  options.keep_going = [this, estop] { return estops_waiting_.load() == 0 && (estop || !stopping_.load()); };
   if (estop) {
     options.retry_interval_s = kEstopRetryIntervalS;
     options.endcap_mask = static_cast<std::uint16_t>(options.endcap_mask | std::exchange(estop_handover_mask_, 0));

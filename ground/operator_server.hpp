@@ -10,6 +10,9 @@
 // one at a time, and an emergency stop preempts whatever is in flight, an older
 // estop too (its acknowledgement wait, not its effect: the preempted command was
 // already sent); the end caps an older estop had not heard from join the newer one.
+// Stopping the console never drops an emergency stop: one in flight, or asked for
+// while stopping, runs to its end (every end cap acked, or its timeout); only the
+// other commands end early.
 #pragma once
 
 #include <atomic>
@@ -42,8 +45,8 @@ class OperatorServer {
   // the console's own keys do.
   CommandReport run(const OperatorRequest& request);
 
-  // Stops accepting (the socket removed), ends commands in flight at their next
-  // check (a few ms); new ones are refused.
+  // Stops accepting (the socket removed), ends a stop or clear-fault in flight at
+  // its next check (a few ms) and refuses new ones; emergency stops still run.
   void shutdown();
 
   const std::filesystem::path& socket_path() const { return socket_path_; }

@@ -27,11 +27,14 @@ namespace tensegrity::test {
 
 class Subprocess {
  public:
+  // `in_file`: the child's stdin (a FIFO the test writes keys into, say); empty: this
+  // process's own.
   Subprocess(const std::vector<std::string>& argv, const std::filesystem::path& out_file,
-             const std::filesystem::path& err_file)
+             const std::filesystem::path& err_file, const std::filesystem::path& in_file = {})
       : out_file_(out_file) {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
+    if (!in_file.empty()) posix_spawn_file_actions_addopen(&actions, 0, in_file.c_str(), O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, 2, err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     std::vector<char*> args;
