@@ -43,7 +43,7 @@ void check_report(const std::string& name, const ground::CommandReport& report) 
 // A console exists but did not send the command. A stop or estop then goes out from
 // this tool; a clear-fault does not: this tool's fresh participant would name the
 // estop counts it hears now, which may include an estop the console saw land since
-// the operator asked, and undo it (docs/dds.md, clear-fault).
+// the operator asked, and undo it (docs/design/dds.md, clear-fault).
 bool speak_instead(const std::string& name, const CommandArgs& args, ground::CommandKind kind,
                    const std::filesystem::path& socket, const std::string& why) {
   if (!args.console.empty()) throw CommandError(1, name + ": the console did not send it: " + why);
@@ -102,7 +102,7 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
 }
 
 // A fresh secured tool needs up to ~6 s to authenticate with twelve end caps
-// (docs/security.md), one rejoin 4 s more: the defaults leave room for both. A
+// (docs/guide/security.md), one rejoin 4 s more: the defaults leave room for both. A
 // clear-fault waits up to 8 s to hear each end cap before it sends (again after a
 // rejoin): 30 s leaves room for one.
 void add_command(CLI::App& app, const std::string& name, const std::string& help, ground::CommandKind kind,

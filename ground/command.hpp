@@ -67,7 +67,7 @@ CommandReport send_command(Station& station, CommandKind kind, std::int64_t star
 
 // For a command that must land (the emergency stop): a secured participant's
 // handshake with an end cap now and then stalls for good in Fast DDS 2.9
-// (docs/security.md), and a fresh ground tool needs seconds to authenticate with
+// (docs/guide/security.md), and a fresh ground tool needs seconds to authenticate with
 // twelve. While end caps are missing and none has acknowledged for `stall_s`, the
 // station is replaced by a new one from `make_station` (a new participant,
 // handshakes afresh) and the command goes on until all acked or the deadline.

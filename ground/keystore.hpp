@@ -11,7 +11,7 @@
 // certificates and S/MIME signatures are made by Debian's `openssl` command: the
 // library's X.509 and PKCS#7 builders would be a few hundred lines that this one
 // well-kept tool already is. Enclave folders hold copies, not links, so one can be
-// copied to an end cap's board as it is. docs/security.md.
+// copied to an end cap's board as it is. docs/guide/security.md.
 #pragma once
 
 #include <filesystem>

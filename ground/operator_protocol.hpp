@@ -3,7 +3,7 @@
 // the console's local socket: one request line and one reply line, JSON, typed here
 // on both sides. The console is a ground station that authenticated with the end
 // caps once and stays up, so a command it relays lands in milliseconds where a fresh
-// secured tool pays seconds of DDS Security handshakes first (docs/security.md).
+// secured tool pays seconds of DDS Security handshakes first (docs/guide/security.md).
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Keeps a long-lived ground station (the operator console's) joined. Fast DDS 2.9's
 // security handshake with an end cap now and then stalls for good
-// (docs/security.md); a fresh participant handshakes afresh. When end caps it
+// (docs/guide/security.md); a fresh participant handshakes afresh. When end caps it
 // should hear stay unheard and the set it hears has not grown for `stall_s`, a
 // second participant is made beside the first; it takes over once it hears all
 // end caps, or after `trial_s` if it hears more than the first, and is dropped

@@ -89,7 +89,7 @@ dds::Topic* create_topic(dds::DomainParticipant& participant, const TopicSpec& s
     // DDS 2.9 encodes it without the XCDR2 headers XTypes 1.3 requires, and a
     // compliant peer (Cyclone DDS 0.10) then drops the whole announcement, so the
     // topic never matches. Fast DDS peers match on the type name and the older
-    // TypeObject (still sent); see docs/dds.md "A second vendor: Cyclone DDS".
+    // TypeObject (still sent); see docs/design/dds.md "A second vendor: Cyclone DDS".
     type->auto_fill_type_information(false);
     if (type.register_type(&participant) != ReturnCode_t::RETCODE_OK) {
       throw DdsError(std::string("cannot register type ") + spec.type);

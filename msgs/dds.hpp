@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // What every DDS participant of the project agrees on: the message-format version,
 // the domain id, the topic names with their QoS profile, and how a participant is
-// made (UDP only, profiles from msgs/qos_profiles.xml). See docs/dds.md.
+// made (UDP only, profiles from msgs/qos_profiles.xml). See docs/design/dds.md.
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -42,7 +42,7 @@ inline constexpr const char* kProfileDurable = "durable_events";
 inline constexpr const char* kProfileStream = "stream";
 inline constexpr const char* kProfileTimeSync = "time_sync";
 // The end cap's command reader: durable_events but VOLATILE, so a fresh end cap is
-// never handed commands a writer kept from before it matched (docs/dds.md).
+// never handed commands a writer kept from before it matched (docs/design/dds.md).
 inline constexpr const char* kProfileFreshCommands = "fresh_commands";
 inline constexpr const char* kParticipantProfile = "tensegrity_participant";
 

@@ -9,7 +9,7 @@
 // its partition names; a sample whose id is not its writer's is refused. A writer
 // whose partition changes after discovery is refused from then on (Fast DDS checks
 // permissions when it matches a writer, not when its QoS changes). So one end cap's
-// identity cannot speak for another. docs/security.md.
+// identity cannot speak for another. docs/guide/security.md.
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>

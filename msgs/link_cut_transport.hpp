@@ -18,7 +18,7 @@ namespace tensegrity::msgs {
 // Wraps `low_level` (the profile's UDPv4 descriptor). While *cut is true nothing
 // goes out or comes in; while *mute is true nothing goes out, and what comes in is
 // delivered: one direction lost, as a security handshake stalled one way leaves a
-// participant (docs/security.md). Either may be null (never). Each must outlive the
+// participant (docs/guide/security.md). Either may be null (never). Each must outlive the
 // participant; it is read on every datagram (relaxed atomic load: a fault takes
 // effect within one datagram, no ordering with other data is needed). Setting one
 // from a signal handler is fine (lock-free atomic<bool>).

@@ -3,7 +3,7 @@
 // and AES-GCM-GMAC plugins): who may publish and read which topic, the keystore's
 // layout (SROS2's: one enclave folder per identity), and the participant properties
 // that turn the plugins on. The governance and permissions documents are made from
-// kAllTopics' writer column, so a new topic cannot be forgotten. docs/security.md.
+// kAllTopics' writer column, so a new topic cannot be forgotten. docs/guide/security.md.
 #pragma once
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>

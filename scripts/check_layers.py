@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """The architecture's rules, enforced: which room may include which, read from the
-declarative table scripts/layers.json (README "What is here", DESIGN.md).
+declarative table scripts/layers.json (README "What is here", docs/design/architecture.md).
 
 Every tracked C++ file belongs to the room whose longest file prefix matches it. Each
 #include "..." of another room's file must name a room in its own room's

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The size rule of the project's guide, enforced: outside tests/, no source file
 over 400 lines and no function over 80 lines, except those listed with a reason in
-scripts/size-exceptions.txt (and docs/architecture.md, "Size exceptions").
+scripts/size-exceptions.txt (and docs/design/architecture.md, "Size exceptions").
 
 Files: a plain line count. Functions: clang-tidy's readability-function-size with
 LineThreshold 80, over the build's compile_commands.json. clang-tidy parses every

@@ -4,7 +4,7 @@
 # replays every seed and recorded crash, then fuzzes each target for SECONDS.
 # New inputs go to a scratch copy of the corpus, never into the repository; a
 # crash stops the run and leaves its input in out/fuzz/<target>/ to become a
-# regression (fuzz/regressions/<target>/, docs/fuzzing.md).
+# regression (fuzz/regressions/<target>/, docs/design/fuzzing.md).
 #   scripts/fuzz.sh [SECONDS=20] [TARGET...]     (default: every target)
 #   FUZZ_RUNS=N   stop each target after N executions instead (long runs)
 #   FUZZ_SEED=N   libFuzzer seed (default 1: a CI run is reproducible)

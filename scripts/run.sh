@@ -9,7 +9,7 @@
 # The robot is the default, the paper's simulated SUPERball (robots/superball-paper.json);
 # --evolve learns with tensegrity evolve's defaults: 40 members per cable population (the
 # author's is 10) and a 0.05 m step annealed to 0.02 m over episodes 2000-5000. With them
-# 10 of seeds 1-10 learned a 33-35 m gait in 5000 episodes (docs/results.md, "The cables");
+# 10 of seeds 1-10 learned a 33-35 m gait in 5000 episodes (docs/reproduction.md, "The cables");
 # seed 1 learns 33.7 m, the shipped policy to the last digit
 # (tests/sim/shipped_policy_test.cpp holds the shipped file to this seed and these settings).
 set -euo pipefail
@@ -42,7 +42,7 @@ if [[ $evolve -eq 1 ]]; then
   policy=out/evolved.json
   echo "== evolving a policy (t = 4 s, n = 5, historical average, population 40, step 0.05 -> 0.02 m, 5000 episodes, seed $seed)"
   # The checkpoint is per robot, seed and schedule: --resume must not continue another
-  # seed's run, nor one begun on the spin-held robot before session 29 (it would be refused).
+  # seed's run, nor one begun on another robot (its robot hash differs: it would be refused).
   "$tensegrity" evolve --robot robots/superball-paper.json --period 4 --complexity 5 --method historical --episodes 5000 \
     --population 40 --replace 20 --seed "$seed" --checkpoint "out/evolve-checkpoint-paper-p40-anneal-s$seed" --resume \
     --out "$policy" --log out/evolve-curve.csv
@@ -58,5 +58,5 @@ echo "== HIL: 12 endcap processes over CAN-over-UDP against the ODE model, locks
 /usr/bin/python3 tools/plot_run.py out/hil-run.csv out/hil-run.png
 robot=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["robot"])' "$policy")
 echo
-echo "== watch the run in a browser (3D replay with plots; docs/view.md):"
+echo "== watch the run in a browser (3D replay with plots; docs/guide/view.md):"
 echo "   $tensegrity view out/hil-run.csv --robot robots/$robot.json    # then open http://127.0.0.1:8080/"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# The sanitizer runs of CI (issue 15), each a subset chosen to fit CI's time:
+# The sanitizer runs of CI, each a subset chosen to fit CI's time:
 #   asan  AddressSanitizer + UndefinedBehaviorSanitizer on every unit-test
 #         executable and the end cap's end-to-end tests (12 real `endcap` processes)
 #   tsan  ThreadSanitizer on the threads that share memory: the control loop's

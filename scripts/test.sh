@@ -33,7 +33,7 @@ echo "test: the DDS-off endcap took $(( $(date +%s) - nodds_start )) s"
 ctest --preset "$preset"
 echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
 # Every decoder of outside input under libFuzzer: corpora and recorded crashes
-# replayed, then 5000 seeded executions per target (docs/fuzzing.md). A count, not
+# replayed, then 5000 seeded executions per target (docs/design/fuzzing.md). A count, not
 # a time: with the seed fixed the run is the same on every machine, so CI cannot
 # go red on an input this checkout was never shown.
 fuzz_start=$(date +%s)

@@ -3,8 +3,8 @@
 // The rigid-body engine under a Model (sim/model.hpp holds one; nothing else uses
 // it). The Model computes cable forces, spin damping and every measure itself;
 // the engine owns the six strut bodies, integrates them and makes their contacts.
-// Two engines answer issue 14's question whether ODE's contacts are why this model
-// learns slower than the Bullet cross-check: ODE (the default) and Bullet.
+// Two engines, so that a result can be checked against the other contact model:
+// ODE (the default) and Bullet, the engine of NTRT, the paper's simulator.
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The Bullet engine (robot.engine "bullet"): Debian's Bullet 3.24 in single precision,
-// as NTRT's Bullet 2.82 and issue 14's cross-check ran it. Capsules collide with a
+// as NTRT's Bullet 2.82 runs it. Capsules collide with a
 // static plane and, with strut.rod_contact, with each other, through Bullet's own
 // collision detection and its sequential-impulse solver at their defaults (ERP 0.2,
 // split impulse, 10 iterations); the robot file's soft-contact stiffness and damping
-// are ODE's and do not apply here (docs/model.md).
+// are ODE's and do not apply here (docs/design/model.md).
 #include <btBulletDynamicsCommon.h>
 
 #include <cmath>

@@ -87,7 +87,7 @@ class OdeEngine final : public Engine {
       bodies_.push_back(body);
       inertia_.emplace_back(mass.I[0], mass.I[5], mass.I[10]);
     }
-    // Soft contact from the robot file's stiffness and damping (docs/model.md).
+    // Soft contact from the robot file's stiffness and damping (docs/design/model.md).
     const double kp = robot.contact_stiffness_n_per_m;
     const double kd = robot.contact_damping_n_s_per_m;
     soft_erp_ = dt_s * kp / (dt_s * kp + kd);

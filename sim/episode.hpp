@@ -38,7 +38,7 @@ struct EpisodeResult {
   double motor_energy_j = 0.0;      // work the motors did shortening cables under tension
   double mean_motor_power_w = 0.0;  // per cable
   // How the struts turned about their own axes (a gait must not skate on spinning
-  // struts, docs/model.md): RMS over struts and steps, and the largest seen.
+  // struts, docs/design/model.md): RMS over struts and steps, and the largest seen.
   double axial_spin_rms_rad_per_s = 0.0;
   double axial_spin_max_rad_per_s = 0.0;
   int endcaps_touched_ground = 0;  // of the robot's end caps, at any step

@@ -60,8 +60,8 @@ void read_gait(const json& provenance, const Robot& robot, const std::string& so
 
 namespace {
 
-// provenance.population / replace / teams: all three or none (policies from before
-// session 22 have none), each a size the coevolution could have run with.
+// provenance.population / replace / teams: all three or none (older policy files
+// have none), each a size the coevolution could have run with.
 void read_sizes(const json& p, const std::string& source, Provenance& pr) {
   const int given = static_cast<int>(p.contains("population")) + static_cast<int>(p.contains("replace")) +
                     static_cast<int>(p.contains("teams"));

@@ -32,15 +32,15 @@ struct Provenance {
   double score_m = 0.0;
   std::string robot_hash;
   std::string created_by = "tensegrity";
-  // The mutation step the coevolution bred with (its schedule: docs/evolve.md), so that
+  // The mutation step the coevolution bred with (its schedule: docs/guide/evolve.md), so that
   // method + seed + episodes + this reproduce the policy. sigma_m 0: not recorded.
   std::string mutation = "gaussian";  // the operator: gaussian | author
   double sigma_m = 0.0;
   double sigma_final_m = 0.0;
   std::int64_t anneal_start_episodes = 0;
   std::int64_t anneal_episodes = 0;
-  // The coevolution's sizes (--population, --replace, --teams): the defaults changed
-  // in session 22, so a policy without them cannot say which it was bred with. 0: not recorded.
+  // The coevolution's sizes (--population, --replace, --teams): the defaults have
+  // changed, so a policy without them cannot say which it was bred with. 0: not recorded.
   int population = 0;
   int replace = 0;
   int teams = 0;

@@ -60,7 +60,7 @@ void parse_nodes(const Reader& r, Robot& robot) {
 }
 
 // The fields that decide how struts turn about their own axes and whether they
-// collide (docs/model.md) are optional, so that older robot files keep their behaviour.
+// collide (docs/design/model.md) are optional, so that older robot files keep their behaviour.
 void parse_strut(const Reader& r, Robot& robot) {
   const Reader strut = r.object("strut");
   robot.strut_mass_kg = strut.positive("mass_kg", 0.0, true);

@@ -43,15 +43,15 @@ struct Robot {
   std::vector<CableSpec> cables;
   double strut_mass_kg = 0.0;
   double strut_radius_m = 0.0;
-  // Viscous damping of a strut's spin about its own axis (see docs/model.md): the
+  // Viscous damping of a strut's spin about its own axis (see docs/design/model.md): the
   // cable attachments at real end caps resist it; point-attached cables cannot.
   double axial_damping_n_m_s = 0.0;
   CableAttachment cable_attachment = CableAttachment::axis;  // strut.cable_attachment
   // strut.rod_contact: struts collide with each other as capsules (as rigid bodies do
-  // in NTRT's Bullet world). Off, they pass through each other (docs/model.md).
+  // in NTRT's Bullet world). Off, they pass through each other (docs/design/model.md).
   bool rod_contact = false;
   // strut.axial_spin "zeroed": after every step a strut's spin about its own axis is
-  // removed, as issue 14's Bullet cross-check did; "free" (default) leaves it to the
+  // removed, as the Bullet cross-check in docs/reproduction.md does; "free" (default) leaves it to the
   // cables, the ground and axial_damping_n_m_s.
   bool zero_axial_spin = false;
   double initial_rest_length_m = 0.0;
@@ -74,8 +74,8 @@ struct Robot {
   double start_clearance_m = 0.05;
   double settle_s = 4.0;
   // The pose the settled start drops: a closed cable triangle turned face down (the
-  // project's default), or the description's own pose, as the Bullet cross-check of
-  // issue 14 started (dropped, 2 s, then scored from wherever it came to lie).
+  // project's default), or the description's own pose, as the Bullet cross-check
+  // starts (dropped, 2 s, then scored from wherever it came to lie).
   enum class StartPose { face_down, description };
   StartPose start_pose = StartPose::face_down;
   // FNV-1a 64 of the canonical JSON, as 16 hex digits: names the exact model a
@@ -96,7 +96,7 @@ Robot load_robot(const std::filesystem::path& path);
 // was built from, or ./robots (the path is returned even when no such file exists).
 std::filesystem::path robot_path_named(const std::string& name);
 // The shipped default: robots/superball-paper.json, the paper's simulated SUPERball
-// (issue 14; docs/model.md). DESIGN.md's hardware is robot_path_named("superball").
+// (docs/design/model.md). The 1.7 m hardware (docs/design/robot.md) is robot_path_named("superball").
 std::filesystem::path default_robot_path();
 // FNV-1a 64-bit of `text`, as 16 lower-case hex digits.
 std::string fnv1a64_hex(const std::string& text);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// Strut body frames and where cables attach on an end cap's surface (docs/model.md,
+// Strut body frames and where cables attach on an end cap's surface (docs/design/model.md,
 // "Strut spin about its own axis").
 #include <Eigen/Core>
 #include <span>

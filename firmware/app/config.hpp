@@ -49,7 +49,7 @@ struct EndcapAppConfig {
   // No fresh load-cell sample (new sequence number, channel valid) for this long
   // trips sensor_timeout; a few SYNC periods.
   double load_cell_sample_timeout_s = 0.02;
-  // Supervision (docs/canopen.md "Supervision"). A drive position (TPDO1) older
+  // Supervision (docs/design/canopen.md "Supervision"). A drive position (TPDO1) older
   // than this trips stale_position; a few SYNC periods.
   double drive_position_timeout_s = 0.02;
   // The end cap's own CANopen node: its heartbeat period (0x1017) and the consumer
@@ -65,7 +65,7 @@ struct EndcapAppConfig {
   double stats_log_period_s = 10.0;
   // DDS Security keystore (tensegrity security init; this end cap uses its enclave
   // enclaves/tensegrity/endcap_NN). Empty: not in the file, so `endcap` needs
-  // --keystore or an explicit --insecure (docs/security.md).
+  // --keystore or an explicit --insecure (docs/guide/security.md).
   std::filesystem::path dds_keystore;
 
   std::int64_t period_ns() const;

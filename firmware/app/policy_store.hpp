@@ -27,7 +27,7 @@ namespace tensegrity::fw::app {
 struct StoredIdentity {
   std::string policy_id;  // empty: none known (a record written before identities were stored)
   std::uint32_t policy_version = 0;
-  std::uint32_t checksum = 0;  // the policy table's checksum (docs/dds.md)
+  std::uint32_t checksum = 0;  // the policy table's checksum (docs/design/dds.md)
 };
 inline constexpr std::size_t kMaxStoredPolicyIdBytes = 64;
 

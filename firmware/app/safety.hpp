@@ -7,7 +7,7 @@
 // silent or booting. The controller latches the first cause; while a condition
 // persists this monitor keeps reporting it, so clearing a fault that is still
 // there trips again on the next cycle. Over-tension is the core's own check.
-// Supervision (docs/canopen.md): a boot-up after bring-up (a node that rebooted
+// Supervision (docs/design/canopen.md): a boot-up after bring-up (a node that rebooted
 // comes back pre-operational and unpowered), a drive out of operation enabled
 // that was not asked to leave it, and a drive position older than its timeout.
 #pragma once

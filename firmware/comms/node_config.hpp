@@ -31,7 +31,7 @@ struct EndcapNodeConfig {
   HostLossAction host_loss = HostLossAction::continue_gait;
   // Hearing hosts that hear other end caps but have not named this one for this
   // long, the node makes a new participant: a stalled security handshake in one
-  // direction outlives any number of fresh hosts (docs/security.md). The wait
+  // direction outlives any number of fresh hosts (docs/guide/security.md). The wait
   // doubles after each rejoin that is not answered, up to 8 times. 0: never.
   double unheard_rejoin_s = 20.0;
   double loop_ack_timeout_s = 2.0;
@@ -47,7 +47,7 @@ struct EndcapNodeConfig {
   const std::atomic<bool>* link_cut = nullptr;
   // Fault injection (HIL): each time *mute_requests grows, the participant of that
   // moment sends nothing more, for good, and still hears: the symptom of a security
-  // handshake stalled one way (docs/security.md), which a new participant clears
+  // handshake stalled one way (docs/guide/security.md), which a new participant clears
   // (node_rejoin.cpp). A counter, so that a signal handler can ask twice. Null: never.
   const std::atomic<std::uint32_t>* mute_requests = nullptr;
   // Watchdog: the control loop's progress counter (bumped by the loop thread every

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The end cap's side of a stalled link. Fast DDS 2.9's security handshake now and
-// then stalls for good in one direction (docs/security.md): an end cap then hears
+// then stalls for good in one direction (docs/guide/security.md): an end cap then hears
 // the host's heartbeat while the host never hears its own, and no new host
 // participant clears it. The host's heartbeat names the end caps it hears; an end
 // cap that hears hosts which hear other end caps but not itself, for

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Policy tables: judge, store (table + identity, one durable record), hand to the
-// loop, acknowledge once the loop took it. docs/dds.md "Policy upload".
+// loop, acknowledge once the loop took it. docs/design/dds.md "Policy upload".
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -39,7 +39,7 @@ std::string format(const char* fmt, auto... args) {
 }  // namespace
 
 namespace {
-// The checksummed encoding (docs/dds.md "Policy checksum").
+// The checksummed encoding (docs/design/dds.md "Policy checksum").
 LeWriter encode(const PolicyTableMsg& msg) {
   LeWriter w;
   w.u32(0x31435054U);  // "TPC1"

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The CSV files of `tensegrity analyze`, one per figure or table (names in
-// docs/results.md, "Figures 10-12"); tools/plot_analysis.py reads them.
+// docs/reproduction.md, "Figures 10-12"); tools/plot_analysis.py reads them.
 #include <filesystem>
 #include <string>
 #include <vector>

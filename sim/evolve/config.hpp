@@ -28,7 +28,7 @@ const char* to_string(FitnessMethod method);
 // Throws ConfigError naming the accepted values.
 FitnessMethod parse_fitness_method(const std::string& text);
 
-// How a copy of a survivor is mutated (docs/evolve.md has both, with sources).
+// How a copy of a survivor is mutated (docs/guide/evolve.md has both, with sources).
 enum class Mutation {
   gaussian,  // every value of every copy moves by N(0, sigma^2), clamped
   // The author's NTRT operator (NeuroEvoMember::mutate): a copy stays as it is with
@@ -56,7 +56,7 @@ struct StepSchedule {
 // What `tensegrity evolve` breeds with under the Gaussian operator when no step option
 // is given: the 0.05 m search step while gaits are being found, then down to 0.02 m by
 // episode 5000, so that a population holding a gait keeps more of it in its copies
-// (docs/results.md, "anneal40": generation mean at 5000 30.3 m against 21.8 m,
+// (docs/reproduction.md, "The model choices, with their evidence", and docs/results/arms/compare-anneal40-5000.csv: generation mean at 5000 30.3 m against 21.8 m,
 // mean best 32.2 m, 8 of 10 seeds at 37-39 m).
 inline constexpr StepSchedule kDefaultGaussianSchedule{0.05, 0.02, 2000, 3000};
 
@@ -64,7 +64,7 @@ struct EvolveConfig {
   FitnessMethod method = FitnessMethod::historical;
   // 40 members, 20 replaced: the author's Config.ini has 10 and 5, which on this
   // model finds a rolling gait in 3 of 10 seeds by 5000 episodes; 40 and 20 find
-  // one in 10 of 10 (docs/results.md, "pop40").
+  // one in 10 of 10 (docs/reproduction.md, "The model choices, with their evidence").
   int population = 40;  // members per cable population
   int teams = 50;       // random teams evaluated per generation
   int replace = 20;     // worst members replaced by mutated copies of the best
@@ -72,7 +72,7 @@ struct EvolveConfig {
   // sigma stays sigma_m for anneal_start_episodes episodes, then goes geometrically
   // to sigma_final_m over anneal_episodes more and stays there; anneal_episodes 0
   // keeps sigma_m. (The paper says only "mutate"; a step that explores a random
-  // start is five times what refines a gait, docs/results.md.)
+  // start is five times what refines a gait, docs/reproduction.md.)
   Mutation mutation = Mutation::gaussian;
   double sigma_m = 0.05;
   double sigma_final_m = 0.05;

@@ -57,7 +57,7 @@ class RealEndcaps : public ::testing::Test {
     // ("Address already in use", seen once in 17 runs under load).
     ports_ = hil::free_udp_ports(2 * kEndcapCount);
     // Unsecured, explicitly: twelve separate end-cap processes with DDS Security
-    // leave one unauthenticated now and then (docs/security.md); the secured link
+    // leave one unauthenticated now and then (docs/guide/security.md); the secured link
     // is tested in security_dds_test.cpp and hil_dds_test.cpp.
   }
   void TearDown() override {

@@ -325,7 +325,7 @@ TEST_F(Estop, AClearFaultIssuedBeforeAnotherToolsEstopDoesNotUndoIt) {
   expect_all_within("CLEARED", cleared_sent, kBoundNs);
 }
 
-// The stand-in for a DDS Security handshake stalled for good (docs/security.md): a
+// The stand-in for a DDS Security handshake stalled for good (docs/guide/security.md): a
 // first station that hears no end cap (it sits on another domain). No ack comes for
 // stall_s, so send_command_rejoining replaces it with a fresh participant, and the
 // emergency stop lands on all twelve.

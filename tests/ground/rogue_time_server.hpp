@@ -25,7 +25,7 @@ namespace dds = eprosima::fastdds::dds;
 
 // A participant that answers every time-sync request an hour ahead, with t3 - t2
 // chosen so that the round trip computes to about 0, and the nonce echoed: the
-// attack of issue 15 (without DDS Security anyone on the domain can do this).
+// attack (without DDS Security anyone on the domain can do this).
 class RogueTimeServer final : public dds::DataReaderListener {
  public:
   // `enclave_dir`: a DDS Security identity to try the attack with (empty: none).

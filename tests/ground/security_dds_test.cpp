@@ -76,7 +76,7 @@ class SecureDds : public ::testing::Test {
     return std::make_unique<Station>(o);
   }
   // A station that heard the end caps of `mask`. Fast DDS 2.9.1's handshake now and
-  // then stalls for good (docs/security.md), and the product rejoins then (the HIL,
+  // then stalls for good (docs/guide/security.md), and the product rejoins then (the HIL,
   // the console, the command tools): so does the test, once, after 15 s.
   static std::unique_ptr<Station> joined(int domain, const fs::path& enclave_dir, std::uint16_t mask, bool synced,
                                          bool serve_time = true) {
