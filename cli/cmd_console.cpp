@@ -132,7 +132,8 @@ void run_console(const ConsoleArgs& args) {
     }
   });
   int shown_reports = 0;
-  std::uint16_t shown_heard = 0xFFFF;
+  std::uint16_t shown_linked = 0xFFFF;
+  std::uint16_t shown_deaf = 0;
   auto next_draw = std::chrono::steady_clock::now();
   while (!signals.token().stop_requested()) {
     const ConsoleKey key = keys.next(std::chrono::milliseconds(50));
@@ -151,12 +152,19 @@ void run_console(const ConsoleArgs& args) {
       shown_reports = reports;
       continue;
     }
-    // Not a terminal (a log, a test): a line when the heard set changes, and each report.
-    const std::uint16_t heard = ground::StationKeeper::heard(*keeper.current(), expected, now, keep.fresh_s);
-    if (heard != shown_heard) {
-      std::printf("console: hears %d of %d end caps (mask 0x%03x)\n", std::popcount(heard), std::popcount(expected),
-                  heard);
-      shown_heard = heard;
+    // Not a terminal (a log, a test): a line when the linked set changes, and each report.
+    // Linked is heard and reached: an end cap heard whose readers ours have not matched
+    // would not get an estop, and is named as such.
+    const std::shared_ptr<ground::Station> station = keeper.current();
+    const std::uint16_t linked = ground::StationKeeper::linked(*station, expected, now, keep.fresh_s);
+    const auto deaf = static_cast<std::uint16_t>(station->heard(now, keep.fresh_s) & expected & ~linked);
+    if (linked != shown_linked || deaf != shown_deaf) {
+      std::printf("console: hears %d of %d end caps (mask 0x%03x)", std::popcount(linked), std::popcount(expected),
+                  linked);
+      if (deaf != 0) std::printf("; heard but not reached, an estop would not land yet: mask 0x%03x", deaf);
+      std::printf("\n");
+      shown_linked = linked;
+      shown_deaf = deaf;
     }
     if (reports != shown_reports) std::printf("%s", last.c_str());
     shown_reports = reports;

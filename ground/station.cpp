@@ -218,8 +218,11 @@ void Station::wait_for_command_acks(std::int64_t deadline_ns) {
 }
 
 std::array<EndcapStatus, kEndcapCount> Station::snapshot() const {
+  const std::uint16_t reach = reached();  // its own locks: taken before this station's
   std::lock_guard lock(mutex_);
-  return status_;
+  std::array<EndcapStatus, kEndcapCount> out = status_;
+  for (int e = 0; e < kEndcapCount; ++e) out[static_cast<std::size_t>(e)].reached = (reach & (1U << e)) != 0;
+  return out;
 }
 
 std::uint16_t Station::heard(std::int64_t now_ns, double fresh_s) const {

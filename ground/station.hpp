@@ -68,6 +68,10 @@ struct EndcapStatus {
   // and count until the next heartbeat).
   std::array<std::uint32_t, 4> left_lives{};
   std::uint64_t stale_life_samples = 0;
+  // At the snapshot: this station's policy-table and command writers are matched
+  // with this end cap's readers (Station::reached). Heard and not reached: what it
+  // writes, an estop too, goes to nobody yet.
+  bool reached = false;
 };
 
 class Station {

@@ -28,9 +28,9 @@ int StationKeeper::rejoins() const {
   return rejoins_;
 }
 
-std::uint16_t StationKeeper::heard(const Station& station, std::uint16_t expected, std::int64_t now_ns,
-                                   double fresh_s) {
-  return static_cast<std::uint16_t>(station.heard(now_ns, fresh_s) & expected);
+std::uint16_t StationKeeper::linked(const Station& station, std::uint16_t expected, std::int64_t now_ns,
+                                    double fresh_s) {
+  return static_cast<std::uint16_t>(station.heard(now_ns, fresh_s) & station.reached() & expected);
 }
 
 void StationKeeper::tick(std::int64_t now_ns) {
@@ -39,14 +39,14 @@ void StationKeeper::tick(std::int64_t now_ns) {
   std::shared_ptr<Station> leaving;
   std::unique_ptr<Station> dropped;
   std::unique_lock lock(mutex_);
-  const std::uint16_t now_heard = heard(*current_, options_.expected, now_ns, options_.fresh_s);
+  const std::uint16_t now_heard = linked(*current_, options_.expected, now_ns, options_.fresh_s);
   if ((now_heard & ~last_heard_) != 0) last_growth_ns_ = now_ns;
   last_heard_ = now_heard;
   if (candidate_) {
     // A candidate takes over when it hears every end cap, or at the end of its
     // trial if it hears more than the current station (not before: one still
     // discovering would win with a partial set).
-    const std::uint16_t got = heard(*candidate_, options_.expected, now_ns, options_.fresh_s);
+    const std::uint16_t got = linked(*candidate_, options_.expected, now_ns, options_.fresh_s);
     const bool trial_over = now_ns - candidate_since_ns_ > static_cast<std::int64_t>(options_.trial_s * 1e9);
     if (got == options_.expected || (trial_over && std::popcount(got) > std::popcount(now_heard))) {
       leaving = std::exchange(current_, std::shared_ptr<Station>(std::move(candidate_)));

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // Keeps a long-lived ground station (the operator console's) joined. Fast DDS 2.9's
 // security handshake with an end cap now and then stalls for good
-// (docs/guide/security.md); a fresh participant handshakes afresh. When end caps it
-// should hear stay unheard and the set it hears has not grown for `stall_s`, a
+// (docs/guide/security.md), also one way only: the station hears the end cap while
+// what it writes never reaches it. A fresh participant handshakes afresh. An end cap
+// counts as linked when it is heard and the station's writers reach its readers
+// (Station::reached); when end caps it should be linked with stay unlinked and that
+// set has not grown for `stall_s`, a
 // second participant is made beside the first; it takes over once it hears all
 // end caps, or after `trial_s` if it hears more than the first, and is dropped
 // otherwise, after which the stall time doubles (an end cap that is switched off
@@ -36,8 +39,10 @@ class StationKeeper {
   void tick(std::int64_t now_ns);
   int rejoins() const;
 
-  // The end caps of `expected` whose heartbeat is at most `fresh_s` old, as a mask.
-  static std::uint16_t heard(const Station& station, std::uint16_t expected, std::int64_t now_ns, double fresh_s);
+  // The end caps of `expected` linked both ways: a heartbeat at most `fresh_s` old,
+  // and the station's policy-table and command writers matched with their readers
+  // (an estop would land). As a mask.
+  static std::uint16_t linked(const Station& station, std::uint16_t expected, std::int64_t now_ns, double fresh_s);
 
  private:
   MakeStation make_;

@@ -85,11 +85,11 @@ std::string format_status_table(const std::array<EndcapStatus, kEndcapCount>& st
       const auto& t = s.telemetry.tension_n();
       std::snprintf(tensions, sizeof tensions, "%.0f/%.0f", t[0], t[1]);
     }
-    std::snprintf(line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s%s\n", e, age_s(s, now_ns),
-                  policy.c_str(), mode_name(hb.mode()), fault_name(hb.fault()), tensions,
+    std::snprintf(line, sizeof line, "%6d  %8.2f  %-24s  %-7s  %-14s  %-15s  %9.3f  %6.3f  %s%s%s\n", e,
+                  age_s(s, now_ns), policy.c_str(), mode_name(hb.mode()), fault_name(hb.fault()), tensions,
                   hb.clock_synced() ? static_cast<double>(hb.clock_offset_ns()) / 1e6 : 0.0,
                   hb.clock_synced() ? static_cast<double>(hb.clock_round_trip_ns()) / 1e6 : 0.0,
-                  hb.host_lost() ? "LOST" : "ok", silent(s, now_ns) ? "  SILENT" : "");
+                  hb.host_lost() ? "LOST" : "ok", silent(s, now_ns) ? "  SILENT" : "", s.reached ? "" : "  UNREACHED");
     out += line;
   }
   return out;
@@ -106,6 +106,7 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
       const auto& hb = s.heartbeat;
       j["heartbeat_age_s"] = age_s(s, now_ns);
       j["heard"] = !silent(s, now_ns);
+      j["reached"] = s.reached;  // our writers match its readers: a command would land
       j["active_policy"] = hb.active_policy_id().to_string();
       j["active_policy_version"] = hb.active_policy_version();
       j["state"] = mode_name(hb.mode());

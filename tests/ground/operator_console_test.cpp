@@ -208,7 +208,7 @@ TEST_F(ConsoleLink, TheKeeperReplacesAStationThatHearsNobody) {
   ASSERT_EQ(keeper.rejoins(), 1);
   const std::shared_ptr<Station> second = keeper.current();
   EXPECT_NE(second, first);
-  EXPECT_EQ(StationKeeper::heard(*second, 0b1111, Station::now_ns(), 2.0), 0b111);
+  EXPECT_EQ(StationKeeper::linked(*second, 0b1111, Station::now_ns(), 2.0), 0b111);
   // Now only the absent end cap 3 is missing: candidates come and go, none wins.
   const auto watch = std::chrono::steady_clock::now() + std::chrono::seconds(4);
   while (std::chrono::steady_clock::now() < watch) {

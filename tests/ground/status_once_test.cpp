@@ -139,5 +139,24 @@ TEST_F(StatusOnce, HonoursEndcaps) {
   EXPECT_NE(err.find("--endcaps"), std::string::npos) << err;
 }
 
+// Heard is not reached: an end cap whose readers this station's writers have not
+// matched is marked, since an estop from here would go to nobody.
+TEST(StatusFormat, AnEndcapHeardButNotReachedIsMarked) {
+  auto status = seen({0, 1});
+  const std::int64_t now_ns = 10'000'000'000;
+  status[0].heartbeat_host_ns = status[1].heartbeat_host_ns = now_ns;
+  status[0].reached = true;
+  const std::string table = format_status_table(status, now_ns, 0b11);
+  const auto row = [&](int e) {
+    const std::size_t at = table.find("\n     " + std::to_string(e) + " ");
+    return table.substr(at + 1, table.find('\n', at + 1) - at - 1);
+  };
+  EXPECT_EQ(row(0).find("UNREACHED"), std::string::npos) << table;
+  EXPECT_NE(row(1).find("UNREACHED"), std::string::npos) << table;
+  const json j = json::parse(format_status_json(status, now_ns, 0b11));
+  EXPECT_EQ(j["endcaps"][0]["reached"], true);
+  EXPECT_EQ(j["endcaps"][1]["reached"], false);
+}
+
 }  // namespace
 }  // namespace tensegrity::ground
