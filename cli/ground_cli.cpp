@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "cli/ground_cli.hpp"
 
-#include <cstdio>
 #include <cstdlib>
 
 #include "cli/commands.hpp"
@@ -24,34 +23,30 @@ void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_ti
 void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure) {
   auto* k = cmd.add_option("--keystore", keystore,
                            "DDS Security keystore (tensegrity security init): speak with its ground identity "
-                           "(default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore if it exists, "
-                           "else unsecured)");
-  auto* i = cmd.add_flag("--insecure", insecure, "Unauthenticated, unencrypted DDS even if TENSEGRITY_KEYSTORE is set");
+                           "(default: TENSEGRITY_KEYSTORE, else ~/.local/share/tensegrity/keystore)");
+  auto* i = cmd.add_flag("--insecure", insecure, "Unauthenticated, unencrypted DDS: only when asked, never a fallback");
   k->excludes(i);
 }
 
+// Secured end caps refuse an unsecured participant, so a tool that fell back to
+// no security would wait its whole timeout and report every end cap missing: it
+// stops at once instead, and unsecured is asked for by name (--insecure).
 std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure) {
   if (insecure) return {};
   // The default keystore is the one `tensegrity hil` makes and uses: when it is
   // there, the tools speak with it, so they hear a HIL run without flags.
   const char* env = std::getenv("TENSEGRITY_KEYSTORE");
   const bool named = !keystore.empty() || (env != nullptr && *env != '\0');
-  if (!named && !std::filesystem::exists(msgs::default_keystore())) {
-    std::fprintf(stderr,
-                 "tensegrity: DDS link unsecured (no keystore: --keystore, TENSEGRITY_KEYSTORE or %s; "
-                 "docs/security.md)\n",
-                 msgs::default_keystore().c_str());
-    return {};
-  }
   const std::filesystem::path store = keystore.empty() ? msgs::default_keystore() : std::filesystem::path(keystore);
   const std::filesystem::path dir = msgs::enclave_dir(store, msgs::enclave_name(role));
-  if (!std::filesystem::exists(dir)) {
-    throw CommandError(2, "no DDS Security keystore at " + store.string() +
-                              ": create one with `tensegrity security init " + store.string() +
-                              "` (and give each end cap its enclave), name another with --keystore, or pass "
-                              "--insecure to speak to end caps without security");
-  }
-  return dir;
+  if (std::filesystem::exists(dir)) return dir;
+  const std::string where =
+      named ? "no DDS Security keystore at " + store.string()
+            : "no DDS Security keystore named (--keystore, TENSEGRITY_KEYSTORE) and none at " + store.string();
+  throw CommandError(2, where + ": create one with `tensegrity security init " + store.string() +
+                            "` (and give each end cap its enclave), name another with --keystore DIR or "
+                            "TENSEGRITY_KEYSTORE, or pass --insecure to speak to end caps that run without security "
+                            "(docs/guide/security.md)");
 }
 
 std::uint16_t parse_endcap_set(const std::string& text) {

@@ -26,8 +26,8 @@ struct GroundOptions {
 };
 
 // The enclave of `role` (ground, or listener for read-only tools) in `keystore`, or
-// in the default keystore (msgs::default_keystore) if it exists; empty (unsecured,
-// said on stderr) when there is none or `insecure`. Throws CommandError(2) when the keystore named is missing.
+// in the default keystore (msgs::default_keystore); empty (unsecured) only with
+// `insecure`. Throws CommandError(2), saying how to get one, when there is none.
 std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure);
 void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure);
 

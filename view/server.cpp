@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "view/server.hpp"
 
+#include <arpa/inet.h>
 #include <httplib.h>
+
+#include <cctype>
 
 #include "view/assets.hpp"
 #include "view/csv_table.hpp"
@@ -10,9 +13,6 @@ namespace tensegrity::view {
 
 namespace {
 
-// Each open event stream holds one thread: enough for several pages and the
-// requests of each.
-constexpr std::size_t kHttpThreads = 24;
 constexpr const char* kThreeModule = "build/three.module.js";
 // With a parameter these types are not ones cpp-httplib compresses: on loopback
 // compression only costs time (its Brotli runs at the slowest quality), and
@@ -37,7 +37,65 @@ void refuse(const httplib::Request&, httplib::Response& res) {
   res.set_content("the view is read-only\n", "text/plain");
 }
 
+bool ip_literal(const std::string& name) {
+  in6_addr a6{};
+  in_addr a4{};
+  if (name.size() > 2 && name.front() == '[' && name.back() == ']') {
+    return ::inet_pton(AF_INET6, name.substr(1, name.size() - 2).c_str(), &a6) == 1;
+  }
+  return ::inet_pton(AF_INET, name.c_str(), &a4) == 1;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Before routing, so a refused request's body is never read: a Host that is not
+// this server's, and a body of unknown length (chunked), which cpp-httplib 0.11
+// would read whole whatever the payload limit.
+httplib::Server::HandlerResponse screen(const httplib::Request& req, httplib::Response& res,
+                                        const ServerOptions& options) {
+  if (!req.has_header("Host")) {
+    res.status = 400;
+    res.set_content("no Host header\n", "text/plain");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  const std::string host = req.get_header_value("Host");
+  if (!host_allowed(host, options)) {
+    res.status = 403;
+    res.set_content("Host '" + host +
+                        "' is not this view's (DNS rebinding protection): open it as http://127.0.0.1:PORT/ or "
+                        "name the host with --allow-host\n",
+                    "text/plain");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  if (req.has_header("Transfer-Encoding")) {
+    res.status = 411;
+    res.set_content("the view takes no request body of unknown length\n", "text/plain");
+    return httplib::Server::HandlerResponse::Handled;
+  }
+  return httplib::Server::HandlerResponse::Unhandled;
+}
+
 }  // namespace
+
+bool host_allowed(const std::string& host, const ServerOptions& options) {
+  // The name without its port: "[::1]:8080" -> "[::1]", "a.b:8080" -> "a.b".
+  std::string name = lower(host);
+  const std::size_t colon = name.rfind(':');
+  if (colon != std::string::npos && name.find(']', colon) == std::string::npos) {
+    const std::string port = name.substr(colon + 1);
+    if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos) return false;
+    name.resize(colon);
+  }
+  if (name.empty()) return false;
+  if (name == "localhost" || ip_literal(name) || name == lower(options.bind)) return true;
+  for (const std::string& allowed : options.allowed_hosts) {
+    if (name == lower(allowed)) return true;
+  }
+  return false;
+}
 
 ViewServer::ViewServer(const ServerOptions& options) : options_(options), http_(std::make_unique<httplib::Server>()) {
   if (!std::filesystem::exists(options_.three_dir / kThreeModule)) {
@@ -45,6 +103,14 @@ ViewServer::ViewServer(const ServerOptions& options) : options_(options), http_(
                      " not found: install Debian's libjs-three (scripts/setup.sh does), or give --three-dir");
   }
   http_->new_task_queue = [] { return new httplib::ThreadPool(kHttpThreads); };
+  http_->set_pre_routing_handler(
+      [this](const httplib::Request& req, httplib::Response& res) { return screen(req, res, options_); });
+  // A body above the limit is skipped, not kept, and answered 413.
+  http_->set_payload_max_length(kMaxRequestBodyBytes);
+  // One request per connection: cpp-httplib serves a connection on one thread,
+  // so an idle keep-alive connection would hold one for 5 s, and the body of a
+  // request refused before it was read would be parsed as the next request.
+  http_->set_keep_alive_max_count(1);
   http_->set_file_extension_and_mimetype_mapping("js", kJavaScript);
   http_->set_mount_point("/three", options_.three_dir.string());
   http_->Get(R"(/|/index\.html|/js/[A-Za-z0-9_\-]+\.js|/[A-Za-z0-9_\-]+\.css)", serve_asset);
@@ -74,8 +140,15 @@ void ViewServer::json(const std::string& path, std::function<std::optional<std::
 
 void ViewServer::events(const std::string& path, EventHub& hub, std::function<std::string()> hello) {
   hubs_.push_back(&hub);
-  http_->Get(path, [&hub, hello = std::move(hello)](const httplib::Request&, httplib::Response& res) {
+  http_->Get(path, [this, &hub, hello = std::move(hello)](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
+    if (streams_.fetch_add(1) >= kMaxEventStreams) {
+      streams_.fetch_sub(1);
+      res.status = 503;
+      res.set_header("Retry-After", "5");
+      res.set_content("too many live pages open (" + std::to_string(kMaxEventStreams) + "): close one\n", "text/plain");
+      return;
+    }
     struct Stream {
       std::uint64_t cursor = 0;
       std::uint64_t skipped = 0;
@@ -99,8 +172,10 @@ void ViewServer::events(const std::string& path, EventHub& hub, std::function<st
           if (chunk.empty()) chunk = ": idle\n\n";
           return sink.write(chunk.data(), chunk.size());
         },
-        [&hub, stream](bool) {
+        // Called once whatever happened, also when the provider never ran.
+        [this, &hub, stream](bool) {
           if (stream->greeted) hub.reader_left();
+          streams_.fetch_sub(1);
         });
   });
 }

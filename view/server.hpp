@@ -3,7 +3,11 @@
 // The view's HTTP server (cpp-httplib): the page from the embedded assets, three.js
 // from Debian's libjs-three directory, and the mode's read-only JSON and event
 // endpoints. Only GET (and HEAD) are served: every other method gets 405, so nothing
-// a page sends can reach the robot through the view.
+// a page sends can reach the robot through the view. What a page elsewhere could
+// still do is held off too: a Host that is not this server's is refused (DNS
+// rebinding), a request body is never taken whole, and the event streams, each
+// holding a thread, are bounded so that the page and the API stay answerable.
+#include <atomic>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -24,7 +28,20 @@ struct ServerOptions {
   std::string bind = "127.0.0.1";
   int port = 8080;  // 0: any free port
   std::filesystem::path three_dir = "/usr/share/javascript/three";
+  // Host names served besides localhost, IP literals and `bind` (a name the page
+  // is opened under on the network, e.g. "ground.local").
+  std::vector<std::string> allowed_hosts;
 };
+
+// HTTP threads, event streams open at once (each holds a thread; more get 503),
+// and the largest request body read (more gets 413; the view takes no bodies).
+inline constexpr std::size_t kHttpThreads = 24;
+inline constexpr std::size_t kMaxEventStreams = 16;
+inline constexpr std::size_t kMaxRequestBodyBytes = 64 * 1024;
+
+// Whether a Host header names this server: localhost, an IP literal (a rebinding
+// page's Host is its own DNS name), `bind`, or one of `allowed`; any port.
+bool host_allowed(const std::string& host, const ServerOptions& options);
 
 class ViewServer {
  public:
@@ -51,7 +68,8 @@ class ViewServer {
   ServerOptions options_;
   std::unique_ptr<httplib::Server> http_;
   std::thread thread_;
-  std::vector<EventHub*> hubs_;  // closed on stop, so that open streams end
+  std::vector<EventHub*> hubs_;          // closed on stop, so that open streams end
+  std::atomic<std::size_t> streams_{0};  // event streams open now
   int port_ = 0;
 };
 

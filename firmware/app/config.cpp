@@ -96,8 +96,19 @@ void parse_nodes(const Reader& top, EndcapAppConfig& c) {
     c.drive_node_ids[i] = node_id(nodes, drives[i], key);
     if (!seen.insert(c.drive_node_ids[i]).second) nodes.fail(key, "node id used twice");
   }
-  if (nodes.has("load_cell") && nodes.at("load_cell").is_null()) {
-    c.use_load_cell = false;
+  // c.use_load_cell is the tension guard, read before: only "tension_guard": "off"
+  // runs without a load cell; a null id must not do it quietly.
+  const bool no_load_cell = !nodes.has("load_cell") || nodes.at("load_cell").is_null();
+  if (!c.use_load_cell) {
+    if (!no_load_cell) {
+      nodes.fail("load_cell",
+                 "a load cell with \"tension_guard\": \"off\": drop one or the other (the guard needs the load cell)");
+    }
+  } else if (nodes.has("load_cell") && nodes.at("load_cell").is_null()) {
+    nodes.fail("load_cell",
+               "null would turn the tension guard off (no tension measured: cutoff_tension_n and "
+               "hard_limit_tension_n not enforced): give the load cell's node id, or, on a bench without one, say "
+               "so with \"tension_guard\": \"off\"");
   } else {
     c.load_cell_node_id = node_id(nodes, nodes.at("load_cell"), "load_cell");
     if (!seen.insert(c.load_cell_node_id).second) nodes.fail("load_cell", "node id used by a drive too");
@@ -161,7 +172,7 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   const json doc = format::parse_json<ConfigError>(json_text, source);
   const Reader top(doc, source, "");
   top.only({"format", "bus", "nodes", "spool", "limits", "initial_rest_length_m", "storage_dir", "loop", "timeouts",
-            "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore"});
+            "drive_abort_connection", "start_on_boot", "stats_log_period_s", "dds_keystore", "tension_guard"});
   if (top.string("format") != "tensegrity-endcap/1") top.fail("format", "expected \"tensegrity-endcap/1\"");
 
   EndcapAppConfig c;
@@ -174,6 +185,9 @@ EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const 
   std::string error;
   if (!parse_can_bus_spec(c.bus, spec, error)) top.fail("bus", error);
 
+  // The guard stops a motor at cutoff_tension_n and the end cap at
+  // hard_limit_tension_n, from the load cell's readings.
+  c.use_load_cell = top.choice("tension_guard", {"on", "off"}, 0) == 0;
   parse_nodes(top, c);
   parse_spool_and_limits(top, c);
   const core::MotorLimits& l = c.limits;
@@ -204,10 +218,7 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
   json doc = {
       {"format", "tensegrity-endcap/1"},
       {"bus", c.bus},
-      {"nodes",
-       {{"drives", drives},
-        {"load_cell", c.use_load_cell ? json(c.load_cell_node_id) : json(nullptr)},
-        {"endcap", c.endcap_node_id}}},
+      {"nodes", {{"drives", drives}, {"endcap", c.endcap_node_id}}},
       {"spool", {{"radius_m", c.spool_radius_m}, {"counts_per_rev", c.counts_per_rev}}},
       {"limits",
        {{"min_rest_length_m", l.min_rest_length_m},
@@ -231,6 +242,11 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
       {"stats_log_period_s", c.stats_log_period_s},
   };
   if (!c.dds_keystore.empty()) doc["dds_keystore"] = c.dds_keystore.string();
+  if (c.use_load_cell) {
+    doc["nodes"]["load_cell"] = c.load_cell_node_id;
+  } else {
+    doc["tension_guard"] = "off";
+  }
   return doc.dump(2) + "\n";
 }
 

@@ -36,6 +36,8 @@ struct EndcapAppConfig {
   std::uint32_t motor_count = 2;
   std::array<std::uint8_t, core::kMaxMotorsPerEndcap> drive_node_ids{1, 3, 0, 0};
   std::uint8_t load_cell_node_id = 2;
+  // The tension guard (cut-off and hard limit) from the load cell's readings; off
+  // only by "tension_guard": "off" (no load cell), warned about at every start.
   bool use_load_cell = true;
   double spool_radius_m = 0.01;
   double counts_per_rev = 4096.0 * 109.0;

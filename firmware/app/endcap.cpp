@@ -67,6 +67,13 @@ void Endcap::configure() {
     throw EndcapError(e.what());
   }
   if (options_.start_on_boot) config_.start_on_boot = true;
+  // Said at every start, so a bench setting that reaches the robot is seen.
+  if (!config_.use_load_cell) {
+    log_line(
+        "WARNING: tension guard OFF (%s: \"tension_guard\": \"off\"): no load cell, cable tension is not "
+        "measured, cutoff_tension_n and hard_limit_tension_n are not enforced",
+        options_.config_path.c_str());
+  }
   std::error_code ec;
   std::filesystem::create_directories(config_.storage_dir, ec);
   if (ec) {

@@ -23,10 +23,11 @@ const char* to_string(CanResult result);
 struct CanCounters {
   std::uint64_t tx_frames = 0;
   std::uint64_t rx_frames = 0;
-  std::uint64_t tx_dropped = 0;        // send() refused: queue full, bus-off, invalid frame
-  std::uint64_t rx_malformed = 0;      // arrived but untrustworthy; dropped
-  std::uint64_t error_frames = 0;      // bus error reports (see can_error.hpp)
-  std::uint32_t last_error_class = 0;  // CAN_ERR_* class bits of the latest report
+  std::uint64_t tx_dropped = 0;         // send() refused: queue full, bus-off, invalid frame
+  std::uint64_t rx_malformed = 0;       // arrived but untrustworthy; dropped
+  std::uint64_t rx_unknown_sender = 0;  // UDP: a datagram from anyone but the peer; dropped
+  std::uint64_t error_frames = 0;       // bus error reports (see can_error.hpp)
+  std::uint32_t last_error_class = 0;   // CAN_ERR_* class bits of the latest report
   bool bus_off = false;
 };
 

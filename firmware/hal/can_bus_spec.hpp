@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Text form of a CAN bus choice, as given on a command line or in a config file:
 //   udp:HOST:PORT[,bind=HOST:PORT][,batch]
-//                                    frames over UDP to HOST:PORT (docs/design/udp-can.md);
-//                                    bind defaults to 0.0.0.0:0 (any port); batch:
+//                                    frames over UDP to HOST:PORT, taken only from
+//                                    HOST:PORT (docs/design/udp-can.md); bind defaults to
+//                                    127.0.0.1:0 (any port, loopback only); batch:
 //                                    send a cycle's frames as one version-2 datagram
 //   socketcan:IFNAME                 a Linux CAN interface, e.g. can0 or vcan0
 #pragma once
@@ -14,7 +15,9 @@
 namespace tensegrity::fw {
 
 struct UdpEndpoint {
-  std::string host = "0.0.0.0";  // IPv4 address or host name
+  // Loopback unless told: a bus bound to every address would be reachable from
+  // the whole network, and it carries the drives' positions and the tensions.
+  std::string host = "127.0.0.1";  // IPv4 address or host name
   std::uint16_t port = 0;
 };
 

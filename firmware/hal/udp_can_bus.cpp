@@ -34,6 +34,18 @@ bool resolve(const UdpEndpoint& endpoint, sockaddr_in& out, std::string& error) 
   return true;
 }
 
+bool is_loopback(const sockaddr_in& a) { return (ntohl(a.sin_addr.s_addr) >> 24) == 127; }
+
+// A socket bound to loopback cannot reach another host: say how to fix the spec
+// instead of failing every send.
+bool reachable(bool bound_loopback, const sockaddr_in& remote, const std::string& host, std::string& error) {
+  if (!bound_loopback || is_loopback(remote)) return true;
+  error = "udp: remote " + host +
+          " is not on loopback, and the bus binds 127.0.0.1 unless told: give bind=ADDR:PORT, the local address "
+          "facing it";
+  return false;
+}
+
 }  // namespace
 
 std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::string& error) {
@@ -41,6 +53,15 @@ std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::stri
   if (!resolve(config.bind, local, error)) {
     error = "udp: bind address: " + error;
     return nullptr;
+  }
+  const bool bound_loopback = is_loopback(local);
+  sockaddr_in remote{};
+  if (config.remote.port != 0) {
+    if (!resolve(config.remote, remote, error)) {
+      error = "udp: remote address: " + error;
+      return nullptr;
+    }
+    if (!reachable(bound_loopback, remote, config.remote.host, error)) return nullptr;
   }
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) {
@@ -55,12 +76,13 @@ std::unique_ptr<UdpCanBus> UdpCanBus::open(const UdpCanConfig& config, std::stri
   }
   socklen_t len = sizeof(local);
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &len);
-  std::unique_ptr<UdpCanBus> bus(new UdpCanBus(fd, ntohs(local.sin_port), config.batch));
+  std::unique_ptr<UdpCanBus> bus(new UdpCanBus(fd, ntohs(local.sin_port), bound_loopback, config.batch));
   if (config.remote.port != 0 && !bus->set_remote(config.remote, error)) return nullptr;
   return bus;
 }
 
-UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port, bool batch) : fd_(fd), local_port_(local_port), batch_(batch) {}
+UdpCanBus::UdpCanBus(int fd, std::uint16_t local_port, bool bound_loopback, bool batch)
+    : fd_(fd), local_port_(local_port), bound_loopback_(bound_loopback), batch_(batch) {}
 
 UdpCanBus::~UdpCanBus() { ::close(fd_); }
 
@@ -70,6 +92,7 @@ bool UdpCanBus::set_remote(const UdpEndpoint& remote, std::string& error) {
     error = "udp: remote address: " + error;
     return false;
   }
+  if (!reachable(bound_loopback_, addr, remote.host, error)) return false;
   remote_addr_be_ = addr.sin_addr.s_addr;
   remote_port_be_ = addr.sin_port;
   return true;
@@ -172,7 +195,10 @@ CanResult UdpCanBus::receive(CanFrame& frame, std::int64_t timeout_ns) {
         case detail::WaitResult::error: last_errno_ = errno; return CanResult::io_error;
       }
     }
-    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC);
+    sockaddr_in from{};
+    socklen_t from_len = sizeof(from);
+    const ssize_t n = ::recvfrom(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC,
+                                 reinterpret_cast<sockaddr*>(&from), &from_len);
     if (n < 0) {
       if (errno == EINTR) continue;
       if (errno != EAGAIN && errno != EWOULDBLOCK) {
@@ -181,6 +207,11 @@ CanResult UdpCanBus::receive(CanFrame& frame, std::int64_t timeout_ns) {
       }
       if (timeout_ns == 0) return CanResult::timeout;
       continue;  // woken without a datagram: wait again
+    }
+    // Only the peer's frames are the bus's (before a remote is set, nobody's).
+    if (remote_port_be_ == 0 || from.sin_port != remote_port_be_ || from.sin_addr.s_addr != remote_addr_be_) {
+      ++counters_.rx_unknown_sender;
+      continue;
     }
     // MSG_TRUNC makes n the datagram's real length even when it did not fit.
     const auto size = static_cast<std::size_t>(n);

@@ -21,14 +21,15 @@
 namespace tensegrity::fw {
 
 struct UdpCanConfig {
-  UdpEndpoint remote;  // where send() goes; port 0 = not yet known (set_remote later)
-  UdpEndpoint bind;    // local address; port 0 = any free port (see local_port())
+  UdpEndpoint remote;  // where send() goes and the only sender taken; port 0 = not yet known (set_remote later)
+  UdpEndpoint bind;    // local address (default loopback); port 0 = any free port (see local_port())
   bool batch = false;  // send version 2, one datagram per flush(): only to a peer that reads it
 };
 
 class UdpCanBus final : public CanBus {
  public:
-  // nullptr and a one-line reason in `error` when the socket cannot be made.
+  // nullptr and a one-line reason in `error` when the socket cannot be made, or
+  // when a remote off loopback is given without a bind address facing it.
   static std::unique_ptr<UdpCanBus> open(const UdpCanConfig& config, std::string& error);
   ~UdpCanBus() override;
   UdpCanBus(const UdpCanBus&) = delete;
@@ -41,6 +42,7 @@ class UdpCanBus final : public CanBus {
   CanResult flush() override;
   CanCounters counters() const override { return counters_; }
 
+  // Until a remote is set, every datagram is dropped (no sender is known).
   bool set_remote(const UdpEndpoint& remote, std::string& error);
   std::uint16_t local_port() const { return local_port_; }
   // Datagrams dropped for `reason` (frame and error_report count as received).
@@ -48,12 +50,13 @@ class UdpCanBus final : public CanBus {
   int last_errno() const { return last_errno_; }
 
  private:
-  UdpCanBus(int fd, std::uint16_t local_port, bool batch);
+  UdpCanBus(int fd, std::uint16_t local_port, bool bound_loopback, bool batch);
   CanResult send_bytes(std::span<const std::uint8_t> bytes, std::size_t frames);
   void take_datagram(std::span<const std::uint8_t> datagram);
 
   int fd_;
   std::uint16_t local_port_;
+  bool bound_loopback_;
   std::uint32_t remote_addr_be_ = 0;  // network byte order, as sockaddr_in wants
   std::uint16_t remote_port_be_ = 0;
   CanCounters counters_;

@@ -185,7 +185,8 @@ void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
 
 TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
   json full = example();
-  full["nodes"] = {{"drives", {5}}, {"load_cell", nullptr}, {"endcap", 100}};
+  full["nodes"] = {{"drives", {5}}, {"endcap", 100}};
+  full["tension_guard"] = "off";
   full["timeouts"] = {{"drive_heartbeat_s", 0.25},  {"load_cell_heartbeat_s", 0.3},
                       {"load_cell_sample_s", 0.05}, {"drive_position_s", 0.04},
                       {"endcap_heartbeat_s", 0.02}, {"drive_consumer_heartbeat_s", 0.07}};
@@ -200,6 +201,30 @@ TEST(EndcapConfig, WhatTheWriterWritesTheReaderReadsBack) {
     expect_same(parse_config(written, 7), c);
     EXPECT_EQ(config_to_json_text(parse_config(written, 7)), written) << "a fixed point";
   }
+}
+
+// Without a load cell no tension is measured, so neither the cut-off nor the hard
+// limit holds: that is never what a null or a left-out node id means, only what
+// a field named for it says.
+TEST(EndcapConfig, TheTensionGuardGoesOffOnlyWhenNamed) {
+  json j = example();
+  j["nodes"]["load_cell"] = nullptr;
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: nodes.load_cell: null would turn the tension guard off"));
+  EXPECT_THAT(error_of(j), HasSubstr("\"tension_guard\": \"off\""));
+  j["nodes"].erase("load_cell");
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.load_cell: missing"));
+  j["tension_guard"] = "off";
+  EXPECT_FALSE(parse_config(j.dump(), 3).use_load_cell);
+  j["nodes"]["load_cell"] = nullptr;
+  EXPECT_FALSE(parse_config(j.dump(), 3).use_load_cell);
+  j["nodes"]["load_cell"] = 2;
+  EXPECT_THAT(error_of(j), HasSubstr("nodes.load_cell: a load cell with \"tension_guard\": \"off\""));
+  j = example();
+  j["tension_guard"] = "on";
+  EXPECT_TRUE(parse_config(j.dump(), 3).use_load_cell);
+  EXPECT_TRUE(parse_config(example().dump(), 3).use_load_cell);
+  j["tension_guard"] = false;
+  EXPECT_THAT(error_of(j), HasSubstr("tension_guard: must be"));
 }
 
 TEST(EndcapConfig, TheDdsKeystoreIsAFolderOrLeftOut) {

@@ -18,7 +18,7 @@ TEST(CanBusSpec, ParsesUdpWithAndWithoutBind) {
   EXPECT_EQ(spec.kind, CanBusSpec::Kind::udp);
   EXPECT_EQ(spec.remote.host, "127.0.0.1");
   EXPECT_EQ(spec.remote.port, 7000);
-  EXPECT_EQ(spec.bind.host, "0.0.0.0");
+  EXPECT_EQ(spec.bind.host, "127.0.0.1") << "loopback unless told";
   EXPECT_EQ(spec.bind.port, 0);
 
   ASSERT_TRUE(parse_can_bus_spec("udp:hil.local:7000,bind=127.0.0.1:7001", spec, error)) << error;

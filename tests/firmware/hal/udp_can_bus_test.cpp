@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <ifaddrs.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "firmware/hal/can_error.hpp"
 #include "firmware/hal/clock.hpp"
+#include "firmware/hal/can_bus_spec.hpp"
 #include "firmware/hal/udp_can_bus.hpp"
 #include "firmware/hal/udp_can_wire.hpp"
 
@@ -43,24 +46,41 @@ Pair make_pair() {
   return p;
 }
 
-// Sends raw bytes to a bus, as a misbehaving peer would.
+// Sends raw bytes to a bus from a socket of its own on loopback, as a
+// misbehaving peer (once made the bus's remote) or a stranger would.
 class RawSender {
  public:
   explicit RawSender(std::uint16_t port) : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {
+    sockaddr_in local{};
+    local.sin_family = AF_INET;
+    local.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(::bind(fd_, reinterpret_cast<const sockaddr*>(&local), sizeof(local)), 0);
+    socklen_t len = sizeof(local);
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&local), &len);
+    port_ = ntohs(local.sin_port);
     to_.sin_family = AF_INET;
     to_.sin_port = htons(port);
     to_.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   }
   ~RawSender() { ::close(fd_); }
-  void send(const std::vector<std::uint8_t>& bytes) {
-    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to_), sizeof(to_)),
+  std::uint16_t port() const { return port_; }
+  void send(const std::vector<std::uint8_t>& bytes) { send_to(to_, bytes); }
+  void send_to(const sockaddr_in& to, const std::vector<std::uint8_t>& bytes) {
+    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to)),
               static_cast<ssize_t>(bytes.size()));
   }
 
  private:
   int fd_;
+  std::uint16_t port_ = 0;
   sockaddr_in to_{};
 };
+
+// b takes `raw` as its peer.
+void listen_to(UdpCanBus& b, const RawSender& raw) {
+  std::string error;
+  ASSERT_TRUE(b.set_remote({"127.0.0.1", raw.port()}, error)) << error;
+}
 
 std::vector<std::uint8_t> valid_bytes(const CanFrame& f) {
   const udp_can::Datagram d = udp_can::encode(f);
@@ -123,6 +143,7 @@ TEST(UdpCanBus, ReceiveTimesOutNonBlockingAndBounded) {
 TEST(UdpCanBus, MalformedDatagramsAreDroppedAndCountedByReason) {
   Pair p = make_pair();
   RawSender raw(p.b->local_port());
+  listen_to(*p.b, raw);
   const std::vector<std::uint8_t> good = valid_bytes(make_frame(0x181, 6, 3));
 
   std::vector<std::uint8_t> too_short(good.begin(), good.end() - 1);
@@ -168,6 +189,7 @@ TEST(UdpCanBus, MalformedDatagramsAreDroppedAndCountedByReason) {
 TEST(UdpCanBus, BusOffReportBlocksSendingUntilRestart) {
   Pair p = make_pair();
   RawSender raw(p.b->local_port());
+  listen_to(*p.b, raw);
   const udp_can::Datagram off = udp_can::encode_error_report(can_error::kBusOff, {});
   raw.send({off.begin(), off.end()});
   CanFrame got;
@@ -198,6 +220,78 @@ TEST(UdpCanBus, SendWithoutRemoteIsAnError) {
   auto bus = UdpCanBus::open({UdpEndpoint{"127.0.0.1", 0}, UdpEndpoint{"127.0.0.1", 0}}, error);
   ASSERT_TRUE(bus) << error;
   EXPECT_EQ(bus->send(make_frame(0x1, 0, 0)), CanResult::io_error);
+}
+
+// Whoever can put a frame on the bus can fake a drive's position or a tension:
+// only the peer's datagrams count. Before a remote is set there is no peer.
+TEST(UdpCanBus, DatagramsFromAnyoneButThePeerAreDroppedAndCounted) {
+  Pair p = make_pair();
+  RawSender stranger(p.b->local_port());
+  const CanFrame forged = make_frame(0x181, 6, 9);
+  stranger.send(valid_bytes(forged));
+  ASSERT_EQ(p.a->send(make_frame(0x182, 6, 1)), CanResult::ok);
+  CanFrame got;
+  ASSERT_EQ(p.b->receive(got, kWaitNs), CanResult::ok);
+  EXPECT_EQ(got, make_frame(0x182, 6, 1)) << "the stranger's frame came through";
+  EXPECT_EQ(p.b->receive(got, 0), CanResult::timeout);
+  EXPECT_EQ(p.b->counters().rx_unknown_sender, 1U);
+  EXPECT_EQ(p.b->counters().rx_frames, 1U);
+
+  std::string error;
+  auto lone = UdpCanBus::open({UdpEndpoint{"127.0.0.1", 0}, UdpEndpoint{"127.0.0.1", 0}}, error);
+  ASSERT_TRUE(lone) << error;
+  RawSender to_lone(lone->local_port());
+  to_lone.send(valid_bytes(forged));
+  EXPECT_EQ(lone->receive(got, 50'000'000), CanResult::timeout);
+  EXPECT_EQ(lone->counters().rx_unknown_sender, 1U);
+}
+
+// The first non-loopback IPv4 address of this machine, if any.
+std::optional<in_addr> outside_address() {
+  ifaddrs* all = nullptr;
+  if (::getifaddrs(&all) != 0) return std::nullopt;
+  std::optional<in_addr> found;
+  for (ifaddrs* i = all; i != nullptr && !found; i = i->ifa_next) {
+    if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET) continue;
+    const in_addr a = reinterpret_cast<const sockaddr_in*>(i->ifa_addr)->sin_addr;
+    if ((ntohl(a.s_addr) >> 24) != 127) found = a;
+  }
+  ::freeifaddrs(all);
+  return found;
+}
+
+TEST(UdpCanBus, BindsLoopbackUnlessTold) {
+  CanBusSpec spec;
+  std::string error;
+  ASSERT_TRUE(parse_can_bus_spec("udp:127.0.0.1:7000", spec, error)) << error;
+  auto bus = UdpCanBus::open({spec.remote, spec.bind}, error);
+  ASSERT_TRUE(bus) << error;
+  const std::optional<in_addr> outside = outside_address();
+  if (!outside) GTEST_SKIP() << "no address but loopback here";
+  // The peer itself, sending to this machine's outside address: only the bind
+  // stands between it and the bus.
+  RawSender peer(bus->local_port());
+  listen_to(*bus, peer);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_addr = *outside;
+  to.sin_port = htons(bus->local_port());
+  peer.send_to(to, valid_bytes(make_frame(0x181, 6, 2)));
+  CanFrame got;
+  EXPECT_EQ(bus->receive(got, 100'000'000), CanResult::timeout) << "a frame reached the bus off loopback";
+  peer.send(valid_bytes(make_frame(0x182, 6, 2)));
+  ASSERT_EQ(bus->receive(got, kWaitNs), CanResult::ok);
+  EXPECT_EQ(got.id, 0x182U);
+}
+
+TEST(UdpCanBus, ARemoteOffLoopbackNeedsABindAddressFacingIt) {
+  std::string error;
+  EXPECT_FALSE(UdpCanBus::open({UdpEndpoint{"192.0.2.1", 7000}, UdpEndpoint{}}, error));
+  EXPECT_NE(error.find("bind="), std::string::npos) << error;
+  auto bus = UdpCanBus::open({UdpEndpoint{"127.0.0.1", 0}, UdpEndpoint{}}, error);
+  ASSERT_TRUE(bus) << error;
+  EXPECT_FALSE(bus->set_remote({"192.0.2.1", 7000}, error));
+  EXPECT_NE(error.find("bind="), std::string::npos) << error;
 }
 
 }  // namespace
