@@ -48,7 +48,7 @@ struct HilArgs {
   double barrier_timeout_s = 2.0;
   double speed = -1.0;  // not given: 1 for a lockstep run with --view, else no limit
   std::string provision = hil::to_string(hil::default_provision());
-  std::string host_loss = "continue";
+  std::string host_loss = "stop";
   int domain = -1;
   std::string keystore;
   int link_attempts = 3;

@@ -44,8 +44,8 @@
 namespace tensegrity::hil {
 
 struct DdsProvisionerConfig {
-  int domain = -1;                     // -1: lease a free one (DomainLease)
-  std::string host_loss = "continue";  // the end caps' --host-loss
+  int domain = -1;                 // -1: lease a free one (DomainLease)
+  std::string host_loss = "stop";  // the end caps' --host-loss
   // DDS Security: the keystore the HIL's ground station and end caps take their
   // enclaves from (created if missing). Empty: unsecured (`hil --insecure`).
   std::filesystem::path keystore;

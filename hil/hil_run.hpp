@@ -45,8 +45,8 @@ struct HilOptions {
   double max_speed = 0.0;  // lockstep: physics at most this many times real time (0: no limit)
   double boot_timeout_s = 30.0;
   Provision provision = default_provision();
-  std::string host_loss = "continue";  // the end caps' --host-loss (dds)
-  int dds_domain = -1;                 // -1: a free one of the HIL's range (dds_domain.hpp)
+  std::string host_loss = "stop";  // the end caps' --host-loss (dds)
+  int dds_domain = -1;             // -1: a free one of the HIL's range (dds_domain.hpp)
   // dds: DDS Security keystore (created if missing); empty: unsecured (--insecure).
   std::filesystem::path dds_keystore;
   double hold_timeout_s = 60.0;  // dds: gate open to physics step 0

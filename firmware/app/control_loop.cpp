@@ -145,11 +145,12 @@ void ControlLoop::apply_host_stops(std::uint32_t estops, std::uint32_t host_loss
     estops_seen_ = estops;
     latch(FaultCause::emergency_stop, time_ns);
   }
+  // A host lost while the gait plays (or is about to) is latched: nobody watches the
+  // robot, so it holds until someone clears it and starts it again. An idle end cap
+  // has nothing to stop, and a start can only come from a host that is back.
   if (ahead(host_loss_stops, host_loss_stops_seen_)) {
     host_loss_stops_seen_ = host_loss_stops;
-    HostCommand stop;
-    stop.kind = CommandKind::stop;
-    apply_command(stop, time_ns);
+    if (controller_.mode() == core::Mode::running || pending_start_) latch(FaultCause::host_lost, time_ns);
   }
 }
 

@@ -150,6 +150,7 @@ void Endcap::start_host_link() {
     node_config.expect.motor_count = config_.motor_count;
     node_config.expect.limits = config_.limits;
     node_config.host_loss = comms::parse_host_loss_action(options_.host_loss);
+    node_config.host_boot_grace_s = options_.host_boot_grace_s;
     node_config.unheard_rejoin_s = options_.unheard_rejoin_s;
     if (config_.mode == LoopMode::lockstep) {
       node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
@@ -192,7 +193,15 @@ void Endcap::activate() {
       }
     }
   });
-  try_realtime_priority(loop_thread_);
+  // Lockstep: the emulator's SYNC owns the loop's time and no deadline is on the wall
+  // clock, so SCHED_FIFO buys only speed, and twelve loops at it beside the stepper
+  // keep both cores of a small host busy: the DDS threads, the host watch's included,
+  // then starve for a second and the end caps judge a live host lost.
+  if (config_.mode == LoopMode::realtime) {
+    try_realtime_priority(loop_thread_);
+  } else {
+    log_line("lockstep: the loop runs at normal priority (SYNC paces it; the DDS threads keep their share)");
+  }
   state_ = State::active;
 }
 

@@ -40,7 +40,8 @@ struct EndcapOptions {
   bool start_on_boot = false;
   double duration_s = 0.0;  // 0: until stopped
   bool no_dds = false;
-  std::string host_loss = "continue";
+  std::string host_loss = "stop";
+  double host_boot_grace_s = 30.0;                       // comms::EndcapNodeConfig::host_boot_grace_s
   double unheard_rejoin_s = 20.0;                        // comms::EndcapNodeConfig::unheard_rejoin_s; 0: never
   int domain = -1;                                       // -1: TENSEGRITY_DOMAIN or the default
   std::filesystem::path keystore;                        // --keystore: overrides the config's dds_keystore

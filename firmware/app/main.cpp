@@ -102,8 +102,15 @@ int main(int argc, char** argv) {
   // Accepted in builds without DDS too (where they change nothing), so that
   // launchers and tests pass the same arguments to every build.
   cli.add_flag("--no-dds", o.no_dds, "run without the DDS link to the host (tables from --policy or storage)");
-  cli.add_option("--host-loss", o.host_loss, "when the host's heartbeat is lost: continue the gait, or stop")
+  cli.add_option("--host-loss", o.host_loss,
+                 "when no host heartbeat came for 1 s, or none within 30 s of the start: stop (a playing end cap "
+                 "holds, latched as the fault host_lost until clear-fault), or continue the open-loop gait")
       ->check(CLI::IsMember({"continue", "stop"}))
+      ->capture_default_str();
+  cli.add_option("--host-boot-grace-s", o.host_boot_grace_s,
+                 "no host heard within this long of the start is a host loss too (an end cap started on boot); "
+                 "at least the 1 s host timeout")
+      ->check(CLI::Range(1.0, 3600.0))
       ->capture_default_str();
   cli.add_option("--unheard-rejoin-s", o.unheard_rejoin_s,
                  "hearing hosts that hear other end caps but not this one for this long, make a new DDS participant "

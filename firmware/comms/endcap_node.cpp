@@ -61,6 +61,7 @@ void EndcapNode::start() {
   next_unsynced_report_ns_ = now + kUnsyncedReportNs;
   loop_progress_ns_ = now;
   participant_since_ns_ = now;
+  started_ns_ = now;
   rejoin_wait_s_ = config_.unheard_rejoin_s;
   running_.store(true);
   thread_ = std::thread([this] { run(); });

@@ -178,6 +178,7 @@ class EndcapNode final : public app::HostLink {
   bool have_active_table_ = false;
   std::int64_t last_host_heartbeat_ns_ = 0;
   bool host_seen_ = false;
+  std::int64_t started_ns_ = 0;  // node clock at start(): the boot grace runs from here
   // Whether any host hears this end cap (node_rejoin.cpp), node clock.
   std::int64_t hearing_since_ns_ = 0;       // host heartbeats arriving without a loss since
   std::int64_t named_ns_ = 0;               // a host heartbeat last named this end cap

@@ -35,6 +35,11 @@ void validate(const EndcapNodeConfig& c) {
   positive(c.heartbeat_rate_hz, "heartbeat_rate_hz", 100.0);
   positive(c.time_sync_interval_s, "time_sync_interval_s", 60.0);
   positive(c.host_timeout_s, "host_timeout_s", 3600.0);
+  positive(c.host_boot_grace_s, "host_boot_grace_s", 3600.0);
+  if (c.host_boot_grace_s < c.host_timeout_s) {
+    throw std::invalid_argument("host_boot_grace_s = " + std::to_string(c.host_boot_grace_s) +
+                                ": expected >= host_timeout_s (" + std::to_string(c.host_timeout_s) + ")");
+  }
   positive(c.loop_ack_timeout_s, "loop_ack_timeout_s", 60.0);
   positive(c.command_max_age_s, "command_max_age_s", 3600.0);
   positive(c.loop_stall_timeout_s, "loop_stall_timeout_s", 60.0);

@@ -28,7 +28,15 @@ struct EndcapNodeConfig {
   double time_sync_interval_s = 0.2;
   // No host heartbeat for this long (after one was seen) is a lost host.
   double host_timeout_s = 1.0;
-  HostLossAction host_loss = HostLossAction::continue_gait;
+  // No host heard within this long of the node's start is a lost host too, so an
+  // end cap started on boot (or restarted) that never hears one does not roll on
+  // unwatched. Long enough for a secured discovery of twelve end caps on a loaded
+  // machine (up to 14 s seen, docs/guide/security.md).
+  double host_boot_grace_s = 30.0;
+  // Stop, latched as the fault host_lost (a clear-fault and a start to go on), as a
+  // drive does when its master goes quiet (CiA 402's abort connection); continue
+  // keeps an open-loop gait playing, only when configured so.
+  HostLossAction host_loss = HostLossAction::stop;
   // Hearing hosts that hear other end caps but have not named this one for this
   // long, the node makes a new participant: a stalled security handshake in one
   // direction outlives any number of fresh hosts (docs/guide/security.md). The wait

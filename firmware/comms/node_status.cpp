@@ -54,12 +54,23 @@ void EndcapNode::apply_mute_fault() {
   log("DDS participant MUTED (fault injection): it hears the host, nothing it sends arrives");
 }
 
+// Armed from the node's start: before any host was heard, the boot grace is the wait.
 void EndcapNode::check_host_loss(std::int64_t now) {
-  const bool lost = host_seen_ && now - last_host_heartbeat_ns_ > std::llround(config_.host_timeout_s * 1e9);
+  const std::int64_t silent_since = host_seen_ ? last_host_heartbeat_ns_ : started_ns_;
+  const double limit_s = host_seen_ ? config_.host_timeout_s : config_.host_boot_grace_s;
+  const bool lost = now - silent_since > std::llround(limit_s * 1e9);
+  // While the host stays lost the stop is asked again at every check, not only when
+  // it went: a start taken meanwhile (from a tool that sends no heartbeat, say) must
+  // not leave the end cap playing unwatched. The loop latches only while playing.
+  if (lost && lost == host_lost_.load() && config_.host_loss == HostLossAction::stop) {
+    host_loss_stops_.fetch_add(1, std::memory_order_acq_rel);
+  }
   if (lost == host_lost_.load()) return;
   host_lost_.store(lost);
   (lost ? host_losses_ : host_returns_).fetch_add(1, std::memory_order_relaxed);
-  log("host %s (configured action: %s)", lost ? "LOST: no heartbeat" : "back", to_string(config_.host_loss));
+  log("host %s (configured action: %s)",
+      lost ? (host_seen_ ? "LOST: no heartbeat" : "LOST: none heard since start") : "back",
+      to_string(config_.host_loss));
   // A counter the loop reads every cycle, like the estop: never refused by a full mailbox.
   if (lost && config_.host_loss == HostLossAction::stop) host_loss_stops_.fetch_add(1, std::memory_order_acq_rel);
   if (lost) note_host_lost();  // perhaps our own doing (node_rejoin.cpp)

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "firmware/comms/reasons.hpp"
+#include "firmware/core/fault.hpp"
 #include "ground/command.hpp"
 #include "ground/upload.hpp"
 #include "msgs/dds.hpp"
@@ -374,8 +375,142 @@ TEST_F(GroundDds, KillingTheHostLeavesEndcapsBehavingAsConfigured) {
     const auto& hb = snap[static_cast<std::size_t>(e)].heartbeat;
     EXPECT_TRUE(hb.host_lost()) << "end cap " << e;
     EXPECT_EQ(hb.host_loss_action(), e >= 6 ? 1U : 0U) << "end cap " << e;
-    EXPECT_EQ(snap[static_cast<std::size_t>(e)].telemetry.mode(), e >= 6 ? 0U : 1U)
-        << "end cap " << e << (e >= 6 ? " should have stopped" : " should keep its gait");
+    EXPECT_EQ(snap[static_cast<std::size_t>(e)].telemetry.mode(), e >= 6 ? 2U : 1U)
+        << "end cap " << e << (e >= 6 ? " should have stopped, latched" : " should keep its gait");
+    if (e >= 6) {
+      EXPECT_EQ(hb.fault(), static_cast<std::uint8_t>(core::FaultCause::host_lost)) << "end cap " << e;
+    }
+  }
+}
+
+// Host loss measured: the host (a process that only sends its heartbeat) is killed
+// while the twelve end caps play; each latches host_lost within 1.5 s of the kill
+// (the 1 s timeout, the node's check, a loop cycle, and a loaded machine's wake-ups).
+// Cuts: TENSEGRITY_HOST_CUTS (default 3; docs/guide/robot.md gives a 50-cut run).
+TEST_F(GroundDds, EveryPlayingEndcapLatchesHostLostWithinOneAndAHalfSecondsOfTheCut) {
+  constexpr int kDomain = 178;
+  constexpr std::int64_t kBoundNs = 1'500'000'000;
+  const char* env = std::getenv("TENSEGRITY_HOST_CUTS");
+  const int cuts = env != nullptr ? std::max(1, std::atoi(env)) : 3;
+  Subprocess& nodes = start_nodes(kDomain);
+  Station& s = station(kDomain, /*heartbeat=*/false);  // an observer, not a host
+  std::vector<double> latency_ms;
+  for (int cut = 0; cut < cuts; ++cut) {
+    host_ = std::make_unique<Subprocess>(std::vector<std::string>{GROUND_TEST_HOST, std::to_string(kDomain)},
+                                         dir_ / "host.out", dir_ / "host.err");
+    ASSERT_TRUE(host_->wait_for_output("READY", std::chrono::seconds(20)));
+    ASSERT_TRUE(s.wait_for_endcaps(kAllEndcaps, true, Station::now_ns() + seconds(15)));
+    // Heard by every end cap: a heartbeat sent after this host came up that says so
+    // (an older one may predate the last cut's loss).
+    const std::int64_t host_up = Station::now_ns();
+    const auto hears_host = [&s, host_up] {
+      const auto snap = s.snapshot();
+      return std::all_of(snap.begin(), snap.end(), [host_up](const auto& e) {
+        return e.heartbeat_host_ns > host_up + 250'000'000 && !e.heartbeat.host_lost();
+      });
+    };
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+    while (!hears_host() && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_TRUE(hears_host()) << "cut " << cut << ": the end caps never heard the host";
+    if (cut == 0) {
+      ASSERT_TRUE(upload(s, messages(make_policy(), 1), UploadOptions{}).all_accepted());
+    }
+    CommandOptions clear;
+    ASSERT_TRUE(send_command(s, CommandKind::clear_fault, 0, clear).all_accepted()) << "cut " << cut;
+    // A start is judged on the loop's state as the node last saw it: wait for the clear.
+    const auto cleared = [&s] {
+      const auto snap = s.snapshot();
+      return std::all_of(snap.begin(), snap.end(), [](const auto& e) { return e.telemetry.fault() == 0; });
+    };
+    const auto clear_until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (!cleared() && std::chrono::steady_clock::now() < clear_until) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    const CommandReport started = send_command(s, CommandKind::start, Station::now_ns() + seconds(0.2), {});
+    ASSERT_TRUE(started.all_accepted()) << "cut " << cut << "\n" << format_command_report(started);
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    std::string modes;  // what each end cap's telemetry said just before the cut
+    for (const auto& e : s.snapshot()) modes += std::to_string(e.telemetry.mode()) + " ";
+    const std::int64_t killed = Station::now_ns();
+    host_->kill_hard();
+    std::map<int, std::int64_t> lost;
+    const std::regex line(R"(HOSTLOST endcap=(\d+) true_ns=(-?\d+))");
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (lost.size() < static_cast<std::size_t>(kEndcapCount) && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      const std::string text = nodes.output();
+      for (std::sregex_iterator it(text.begin(), text.end(), line), end; it != end; ++it) {
+        const std::int64_t t = std::stoll((*it)[2]);
+        if (t >= killed) lost.emplace(std::stoi((*it)[1]), t);
+      }
+    }
+    ASSERT_EQ(lost.size(), static_cast<std::size_t>(kEndcapCount))
+        << "cut " << cut << ": not every end cap latched; modes at the cut: " << modes << "\n"
+        << nodes.output().substr(nodes.output().size() > 2000 ? nodes.output().size() - 2000 : 0) << "\n"
+        << [this] {
+             std::ifstream in(dir_ / "nodes0.err");
+             const std::string t((std::istreambuf_iterator<char>(in)), {});
+             return t.substr(t.size() > 4000 ? t.size() - 4000 : 0);
+           }();
+    for (const auto& [e, t] : lost) {
+      EXPECT_LE(t - killed, kBoundNs) << "cut " << cut << ", end cap " << e;
+      latency_ms.push_back(static_cast<double>(t - killed) / 1e6);
+    }
+  }
+  std::sort(latency_ms.begin(), latency_ms.end());
+  std::printf("MEASURE host loss to host_lost latched, %d cut(s) x 12 end caps: median %.0f ms, max %.0f ms\n", cuts,
+              latency_ms[latency_ms.size() / 2], latency_ms.back());
+}
+
+// An end cap that never hears a host (started on boot, say) judges it lost once its
+// boot grace has passed, not never; an observer without a heartbeat of its own does
+// not count as a host.
+TEST_F(GroundDds, AnEndcapThatNeverHearsAHostJudgesItLostAfterItsBootGrace) {
+  constexpr int kDomain = 174;
+  const std::int64_t started = Station::now_ns();
+  start_nodes(kDomain, {"--endcaps", "0-2", "--host-boot-grace-s", "3"});
+  Station& s = station(kDomain, /*heartbeat=*/false);
+  ASSERT_TRUE(s.wait_for_endcaps(0b111, false, Station::now_ns() + seconds(15)));
+  const auto lost_count = [&s] {
+    int n = 0;
+    for (int e = 0; e < 3; ++e) n += s.snapshot()[static_cast<std::size_t>(e)].heartbeat.host_lost() ? 1 : 0;
+    return n;
+  };
+  if (Station::now_ns() - started < seconds(2.5)) {
+    EXPECT_EQ(lost_count(), 0) << "lost before the grace ran out";
+  }
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (lost_count() < 3 && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(lost_count(), 3) << "an end cap never judged the host it never heard lost";
+
+  // A start taken while the host stays lost (from a tool that sends no heartbeat) is
+  // stopped at once, not played unwatched: the stop is asked for as long as the loss lasts.
+  ASSERT_TRUE(s.wait_for_endcaps(0b111, true, Station::now_ns() + seconds(15)));
+  auto tables = messages(make_policy(), 1);
+  std::erase_if(tables, [](const msg::PolicyTable_& t) { return t.target_endcap() > 2; });
+  ASSERT_TRUE(upload(s, tables, UploadOptions{}).all_accepted());
+  CommandOptions co;
+  co.endcap_mask = 0b111;
+  const std::int64_t start_at = Station::now_ns() + seconds(0.2);
+  send_command(s, CommandKind::start, start_at, co);
+  const auto latched = [&] {
+    int n = 0;
+    const std::string text = nodes_.front()->output();
+    for (int e = 0; e < 3; ++e) n += text.find("HOSTLOST endcap=" + std::to_string(e) + " ") != std::string::npos;
+    return n;
+  };
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (latched() < 3 && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(latched(), 3) << "an end cap played on without a host";
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  for (int e = 0; e < 3; ++e) {
+    EXPECT_NE(s.snapshot()[static_cast<std::size_t>(e)].telemetry.mode(), 1U) << "end cap " << e << " still playing";
   }
 }
 

@@ -35,9 +35,11 @@ class ScriptedHostLink final : public HostLink {
     if (before_estops_read) before_estops_read();  // what the node's thread does at that instant
     return estops;
   }
+  std::uint32_t host_loss_stops() const noexcept override { return host_losses; }
 
   std::function<void()> before_estops_read;
   std::uint32_t estops = 0;
+  std::uint32_t host_losses = 0;
   std::deque<HostTable> tables;
   std::deque<HostCommand> commands;
   Telemetry last;

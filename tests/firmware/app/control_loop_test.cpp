@@ -138,6 +138,38 @@ TEST(ControlLoop, EmergencyStopCommandLatches) {
   EXPECT_EQ(b.loop->master().power_request(), canopen::PowerRequest::quick_stop);
 }
 
+// A host lost while the gait plays: latched as host_lost (the drives hold the measured
+// rest lengths, powered) in the next cycle, and it takes a clear-fault to go on.
+TEST(ControlLoop, AHostLostWhilePlayingLatchesUntilCleared) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  b.host.host_losses = 1;
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::host_lost);
+  EXPECT_FALSE(b.running());
+  EXPECT_TRUE(b.has_event(AppEventKind::fault_latched));
+  EXPECT_NE(b.loop->master().power_request(), canopen::PowerRequest::quick_stop) << "held, not quick-stopped";
+  b.host.commands.push_back({CommandKind::start, 0});
+  b.cycle();
+  EXPECT_FALSE(b.running()) << "a start without a clear-fault";
+  b.host.commands.push_back({CommandKind::clear_fault, 0});
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
+}
+
+// Idle, there is nothing to stop: a host loss latches nothing (a start can only come
+// from a host that is back).
+TEST(ControlLoop, AHostLostWhileIdleLatchesNothing) {
+  AppBench b;
+  ASSERT_TRUE(b.start_running());
+  b.host.commands.push_back({CommandKind::stop, 0});
+  b.cycle();
+  ASSERT_FALSE(b.running());
+  b.host.host_losses = 1;
+  b.cycle();
+  EXPECT_EQ(b.loop->controller().fault(), FaultCause::none);
+}
+
 TEST(ControlLoop, EmergencyStopCounterLatchesInTheNextCycleWhateverTheMailboxHolds) {
   AppBench b;
   ASSERT_TRUE(b.start_running());

@@ -4,7 +4,7 @@
 // SIGTERM/SIGINT. Prints "READY" once every node is up.
 //
 //   comms_test_node --domain D [--endcaps 0-11] [--loop-hz 500] [--telemetry-hz 100]
-//     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1]
+//     [--host-loss continue|stop] [--stop-on-host-loss 6-11] [--host-timeout-s 1] [--host-boot-grace-s 30]
 //     [--clock-offset-spread-s 0] [--storage DIR] [--motor-count 2] [--quiet]
 //     [--stall-commands] [--dds-cut-signals] [--keystore DIR] [--unheard-rejoin-s S]
 //     [--loop-stall-after-s S [--loop-stall-for-s D]] [--dds-mute-after-s S]
@@ -113,6 +113,8 @@ int main(int argc, char** argv) {
         base.unheard_rejoin_s = std::stod(value());
       else if (arg == "--host-timeout-s")
         base.host_timeout_s = std::stod(value());
+      else if (arg == "--host-boot-grace-s")
+        base.host_boot_grace_s = std::stod(value());
       else if (arg == "--clock-offset-spread-s")
         spread_s = std::stod(value());
       else if (arg == "--storage")

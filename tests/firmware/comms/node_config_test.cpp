@@ -58,5 +58,23 @@ TEST(NodeConfig, TheEndcapIdIsOneOfTheRobotsTwelve) {
 
 TEST(NodeConfig, TheDefaultsAreValid) { EXPECT_NO_THROW(validate(EndcapNodeConfig{})); }
 
+// Stop is the default: an end cap left without its host holds, latched.
+TEST(NodeConfig, HostLossStopsByDefaultAndTheBootGraceIsNoShorterThanTheTimeout) {
+  const EndcapNodeConfig defaults;
+  EXPECT_EQ(defaults.host_loss, HostLossAction::stop);
+  EndcapNodeConfig c;
+  c.host_boot_grace_s = c.host_timeout_s;
+  EXPECT_NO_THROW(validate(c));
+  for (const double bad : {0.5, 0.0, -1.0, std::nan("")}) {
+    c.host_boot_grace_s = bad;
+    try {
+      validate(c);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("host_boot_grace_s"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tensegrity::fw::comms

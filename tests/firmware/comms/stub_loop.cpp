@@ -95,11 +95,14 @@ void StubLoop::cycle(std::int64_t loop_ns, double dt_s) {
     apply(command, loop_ns);
   }
   apply_estops(host_.emergency_stops());
+  // As the real loop (firmware/app/control_loop.cpp): a loss while playing latches.
   if (host_.host_loss_stops() != host_loss_stops_seen_) {
     host_loss_stops_seen_ = host_.host_loss_stops();
-    fw::app::HostCommand stop;
-    stop.kind = fw::app::CommandKind::stop;
-    apply(stop, loop_ns);
+    if (controller_.mode() == core::Mode::running || pending_start_) {
+      pending_start_ = false;
+      controller_.trip(core::FaultCause::host_lost);
+      std::printf("HOSTLOST endcap=%d true_ns=%lld\n", endcap_, true_now_ns());
+    }
   }
   if (pending_start_ && loop_ns >= pending_start_ns_) {
     pending_start_ = false;
