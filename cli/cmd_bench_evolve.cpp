@@ -2,8 +2,12 @@
 // `tensegrity bench evolve`: episodes per second during a short real evolution (the
 // paper's defaults, physics on a thread pool), per core, and the speed-up over one
 // thread. Also checks on the way that both runs gave the same curve.
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -24,6 +28,25 @@ struct BenchEvolveArgs {
   double duration_s = 60.0;
   bool json = false;
 };
+
+// The targets: 5000 episodes in at most 3 minutes on the machine's cores.
+constexpr double kTargetEpisodes = 5000.0;
+constexpr double kTarget5000EpisodesWallS = 180.0;
+
+// Resident memory now, kB (/proc/self/statm counts pages), so that a long run shows
+// whether it grows; -1 where /proc is missing.
+long resident_kb() {
+  std::ifstream statm("/proc/self/statm");
+  long size_pages = 0;
+  long resident_pages = 0;
+  if (!(statm >> size_pages >> resident_pages)) return -1;
+  return resident_pages * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+long peak_resident_kb() {
+  rusage usage{};
+  return getrusage(RUSAGE_SELF, &usage) == 0 ? usage.ru_maxrss : -1;
+}
 
 struct Timed {
   double wall_s = 0.0;
@@ -56,6 +79,7 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
   if (threads > 1) one = time_run(robot, config, 1);
   const double per_core = many.episodes_per_s / threads;
   const bool identical = threads == 1 || one.curve == many.curve;
+  const double projected_s = kTargetEpisodes / many.episodes_per_s;
   if (args.json) {
     nlohmann::json j = {{"benchmark", "evolve"},
                         {"episodes", args.episodes},
@@ -63,7 +87,12 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
                         {"threads", threads},
                         {"wall_s", many.wall_s},
                         {"episodes_per_s", many.episodes_per_s},
-                        {"episodes_per_s_per_core", per_core}};
+                        {"episodes_per_s_per_core", per_core},
+                        {"projected_5000_episodes_wall_s", projected_s},
+                        {"target_5000_episodes_wall_s", kTarget5000EpisodesWallS},
+                        {"ratio_to_target", kTarget5000EpisodesWallS / projected_s},
+                        {"rss_kb", resident_kb()},
+                        {"max_rss_kb", peak_resident_kb()}};
     if (threads > 1) {
       j["one_thread_episodes_per_s"] = one.episodes_per_s;
       j["speedup_over_one_thread"] = many.episodes_per_s / one.episodes_per_s;
@@ -75,6 +104,9 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
     std::printf("bench evolve: %lld episodes of %.0f s (teams of 50, historical), %d threads\n",
                 static_cast<long long>(args.episodes), args.duration_s, threads);
     std::printf("  %.2f episodes/s, %.2f per core, %.1f s wall\n", many.episodes_per_s, per_core, many.wall_s);
+    std::printf("  5000 episodes would take %.0f s; target %.0f s, ratio %.2f\n", projected_s, kTarget5000EpisodesWallS,
+                kTarget5000EpisodesWallS / projected_s);
+    std::printf("  resident memory %ld kB now, %ld kB at most\n", resident_kb(), peak_resident_kb());
     if (threads > 1) {
       std::printf("  1 thread: %.2f episodes/s; speed-up %.2fx (efficiency %.0f%%); same curve: %s\n",
                   one.episodes_per_s, many.episodes_per_s / one.episodes_per_s,

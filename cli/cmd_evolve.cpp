@@ -16,6 +16,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/evolve_mpi.hpp"
+#include "cli/evolve_policy.hpp"
 #include "cli/evolve_progress.hpp"
 #include "sim/evolve/checkpoint.hpp"
 #include "sim/evolve/driver.hpp"
@@ -48,6 +49,7 @@ struct EvolveArgs {
   std::int64_t anneal_episodes = -1;
   std::int64_t anneal_start_episodes = -1;
   double duration_s = 60.0;
+  double dt_s = 0.0;
   std::string out;
   std::string log;
   bool json = false;
@@ -124,47 +126,13 @@ sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot
   config.complexity = args.complexity;
   config.period_s = args.period_s;
   config.duration_s = args.duration_s;
+  config.dt_s = args.dt_s;
   try {
     sim::evolve::validate(config);
   } catch (const sim::evolve::ConfigError& e) {
     throw CommandError(2, e.what());
   }
   return config;
-}
-
-// The best team as a policy file, with how it was made.
-sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig& config,
-                        const sim::evolve::Coevolution& evo, double score_m) {
-  sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, evo.best().team);
-  policy.provenance.method = sim::evolve::to_string(config.method);
-  policy.provenance.seed = config.seed;
-  policy.provenance.episodes = evo.episodes();
-  policy.provenance.score_m = score_m;
-  policy.provenance.robot_hash = robot.hash;
-  policy.provenance.population = config.population;
-  policy.provenance.replace = config.replace;
-  policy.provenance.teams = config.teams;
-  policy.provenance.mutation = sim::evolve::to_string(config.mutation);
-  policy.provenance.sigma_m = config.sigma_m;
-  policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
-  policy.provenance.anneal_episodes = config.anneal_episodes;
-  policy.provenance.anneal_start_episodes = config.anneal_episodes > 0 ? config.anneal_start_episodes : 0;
-  return policy;
-}
-
-// The gait's strut spin and ground contacts, from one more episode of the policy
-// through the control core: every learned gait reports whether it rolls or skates.
-sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveConfig& config, sim::Policy& policy) {
-  sim::CoreController controller(robot, policy);
-  sim::EpisodeOptions episode;
-  episode.duration_s = config.duration_s;
-  const sim::EpisodeResult gait = sim::run_episode(robot, controller, episode);
-  policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
-  policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
-  policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
-  policy.provenance.min_strut_gap_m = gait.min_strut_gap_m;
-  policy.provenance.strut_overlap_s = gait.strut_overlap_s;
-  return gait;
 }
 
 // What the summary shows beside the evolution itself.
@@ -184,6 +152,7 @@ void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
                       {"best_feasible", evo.best().feasible},
                       {"final_score_m", o.final_result.score_m},
                       {"final_feasible", o.final_result.feasible},
+                      {"robot_step_score_m", o.gait.feasible ? o.gait.distance_m : 0.0},
                       {"episodes", evo.episodes()},
                       {"generations", evo.generation()},
                       {"infeasible_rate_last", evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate()},
@@ -216,6 +185,10 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
               static_cast<long long>(evo.episodes()), o.result.resumed ? " (resumed)" : "");
   std::printf("  best team  %.3f m (generation %d), re-evaluated %.3f m%s\n", best.score_m, best.generation,
               o.final_result.score_m, o.final_result.feasible ? "" : " INFEASIBLE");
+  if (config.dt_s > 0.0) {
+    std::printf("  scored at dt %.4g s; at the robot's own step it rolls %.3f m%s (the policy's score)\n", config.dt_s,
+                o.gait.distance_m, o.gait.feasible ? "" : " INFEASIBLE");
+  }
   std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
   std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
               o.gait.axial_spin_rms_rad_per_s, o.gait.axial_spin_max_rad_per_s, o.gait.endcaps_touched_ground);
@@ -381,6 +354,9 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 3600.0));
+  cmd->add_option("--dt", args->dt_s,
+                  "Time step teams are scored at, seconds (default: the robot's; docs/design/performance.md)")
+      ->check(CLI::Range(1e-5, 0.01));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");

@@ -33,7 +33,12 @@ Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s) {
     end_sign_of_node_[strut.node_b] = +1.0;
   }
   body_.resize(robot_.struts.size());
-  overlaps_.reserve(robot_.struts.size() * (robot_.struts.size() - 1) / 2);
+  const int struts = static_cast<int>(robot_.struts.size());
+  for (int i = 0; i < struts; ++i) {
+    for (int j = i + 1; j < struts; ++j) strut_pairs_.emplace_back(i, j);
+  }
+  axis_m_.assign(robot_.struts.size(), Eigen::Vector3d::Zero());
+  overlaps_.reserve(strut_pairs_.size());
   const auto cables = static_cast<std::size_t>(robot_.cable_count());
   rest_length_m_.assign(cables, robot_.initial_rest_length_m);
   length_m_.assign(cables, 0.0);

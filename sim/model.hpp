@@ -11,6 +11,7 @@
 #include <memory>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "sim/engine.hpp"
@@ -79,6 +80,9 @@ class Model {
   double min_strut_gap_m() const { return min_strut_gap_m_; }
   // Strut-strut contact joints made in the last step (robot.rod_contact only).
   int strut_contact_count() const { return strut_contact_count_; }
+  // Pairs of struts whose closest approach the last step computed exactly; the others
+  // were proven too far apart to touch or to be the closest.
+  int strut_pairs_measured() const { return strut_pairs_measured_; }
 
   // Switches for the energy-conservation test; defaults follow the robot.
   void set_gravity_enabled(bool on);
@@ -92,6 +96,12 @@ class Model {
   void apply_forces();
   // Closest approach of every pair of struts; overlaps_ when they collide.
   void measure_strut_gaps();  // model_strut_contact.cpp
+  struct Approach {
+    double distance_m = 0.0;
+    Eigen::Vector3d on_a = Eigen::Vector3d::Zero();
+    Eigen::Vector3d on_b = Eigen::Vector3d::Zero();
+  };
+  Approach closest_approach(std::size_t pair) const;  // of the axes of strut_pairs_[pair]
   void remove_axial_spin();
   // Surface attachment: body-frame offsets of every cable end from its end cap centre.
   void init_surface_attachments();
@@ -102,6 +112,11 @@ class Model {
   std::unique_ptr<Engine> engine_;
   std::vector<BodyState> body_;  // per strut, as the engine last reported it
   std::vector<StrutOverlap> overlaps_;
+  // Every pair of struts (i < j, in order), the pair that came closest in the last
+  // step (only where the search starts: it changes no result) and per strut its axis.
+  std::vector<std::pair<int, int>> strut_pairs_;
+  std::size_t closest_pair_ = 0;
+  std::vector<Eigen::Vector3d> axis_m_;
   // Per strut: half length, and per node the strut and the sign of its end.
   std::vector<double> half_length_m_;
   std::vector<int> strut_of_node_;
@@ -123,6 +138,7 @@ class Model {
   bool damping_enabled_ = true;
   int contact_count_ = 0;
   int strut_contact_count_ = 0;
+  int strut_pairs_measured_ = 0;
   double min_strut_gap_m_ = std::numeric_limits<double>::infinity();
   bool diverged_ = false;
 };

@@ -62,6 +62,7 @@ void validate(const EvolveConfig& c) {
   }
   if (!(c.period_s > 0.0) || !std::isfinite(c.period_s)) fail("period_s must be > 0");
   if (!(c.duration_s > 0.0) || !std::isfinite(c.duration_s)) fail("duration_s must be > 0");
+  if (!(c.dt_s >= 0.0 && c.dt_s <= 0.01)) fail("dt_s must be in [0, 0.01] (0: the robot's step)");
 }
 
 double mutation_sigma_m(const EvolveConfig& c, std::int64_t episodes_done) {
@@ -74,26 +75,29 @@ double mutation_sigma_m(const EvolveConfig& c, std::int64_t episodes_done) {
 }
 
 nlohmann::json config_to_json(const EvolveConfig& c) {
-  return nlohmann::json{{"method", to_string(c.method)},
-                        {"population", c.population},
-                        {"teams", c.teams},
-                        {"replace", c.replace},
-                        {"mutation", to_string(c.mutation)},
-                        {"sigma_m", c.sigma_m},
-                        // Without annealing the final step is the step, whatever the field holds.
-                        {"sigma_final_m", c.anneal_episodes > 0 ? c.sigma_final_m : c.sigma_m},
-                        {"anneal_start_episodes", c.anneal_episodes > 0 ? c.anneal_start_episodes : 0},
-                        {"anneal_episodes", c.anneal_episodes},
-                        {"seed", c.seed},
-                        {"episodes", c.episodes},
-                        {"cables", c.cables},
-                        {"complexity", c.complexity},
-                        {"min_rest_length_m", c.min_rest_length_m},
-                        {"max_rest_length_m", c.max_rest_length_m},
-                        {"period_s", c.period_s},
-                        {"duration_s", c.duration_s},
-                        {"robot_name", c.robot_name},
-                        {"robot_hash", c.robot_hash}};
+  nlohmann::json j{{"method", to_string(c.method)},
+                   {"population", c.population},
+                   {"teams", c.teams},
+                   {"replace", c.replace},
+                   {"mutation", to_string(c.mutation)},
+                   {"sigma_m", c.sigma_m},
+                   // Without annealing the final step is the step, whatever the field holds.
+                   {"sigma_final_m", c.anneal_episodes > 0 ? c.sigma_final_m : c.sigma_m},
+                   {"anneal_start_episodes", c.anneal_episodes > 0 ? c.anneal_start_episodes : 0},
+                   {"anneal_episodes", c.anneal_episodes},
+                   {"seed", c.seed},
+                   {"episodes", c.episodes},
+                   {"cables", c.cables},
+                   {"complexity", c.complexity},
+                   {"min_rest_length_m", c.min_rest_length_m},
+                   {"max_rest_length_m", c.max_rest_length_m},
+                   {"period_s", c.period_s},
+                   {"duration_s", c.duration_s},
+                   {"robot_name", c.robot_name},
+                   {"robot_hash", c.robot_hash}};
+  // Written only when set, so that a run at the robot's own step writes what it did.
+  if (c.dt_s > 0.0) j["dt_s"] = c.dt_s;
+  return j;
 }
 
 EvolveConfig config_from_json(const nlohmann::json& j) {
@@ -118,6 +122,7 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     c.max_rest_length_m = j.at("max_rest_length_m").get<double>();
     c.period_s = j.at("period_s").get<double>();
     c.duration_s = j.at("duration_s").get<double>();
+    c.dt_s = j.value("dt_s", 0.0);
     c.robot_name = j.at("robot_name").get<std::string>();
     c.robot_hash = j.at("robot_hash").get<std::string>();
     return c;
@@ -130,8 +135,12 @@ std::vector<std::string> config_differences(const EvolveConfig& a, const EvolveC
   const nlohmann::json ja = config_to_json(a);
   const nlohmann::json jb = config_to_json(b);
   std::vector<std::string> out;
-  for (const auto& [key, value] : ja.items()) {
-    if (value != jb.at(key)) out.push_back(key + ": " + value.dump() + " -> " + jb.at(key).dump());
+  auto field = [](const nlohmann::json& j, const std::string& key) { return j.contains(key) ? j.at(key) : nullptr; };
+  nlohmann::json keys = ja;
+  keys.update(jb);
+  for (const auto& [key, value] : keys.items()) {
+    if (field(ja, key) != field(jb, key))
+      out.push_back(key + ": " + field(ja, key).dump() + " -> " + field(jb, key).dump());
   }
   return out;
 }

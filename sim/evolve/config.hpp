@@ -87,6 +87,8 @@ struct EvolveConfig {
   // What the teams are evaluated on; the algorithm itself does not read these.
   double period_s = 4.0;
   double duration_s = 60.0;
+  // The time step teams are scored at, s; 0: the robot's own (its time_step_s).
+  double dt_s = 0.0;
   std::string robot_name;
   std::string robot_hash;
 };

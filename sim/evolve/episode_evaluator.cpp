@@ -18,11 +18,13 @@ Policy team_policy(const Robot& robot, double period_s, int complexity, const Te
   return policy;
 }
 
-TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, const Team& team) {
+TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, double dt_s,
+                         const Team& team) {
   const Policy policy = team_policy(robot, period_s, complexity, team);
   CoreController controller(robot, policy);
   EpisodeOptions options;
   options.duration_s = duration_s;
+  options.dt_s = dt_s;
   options.start = StartKind::settled;
   const EpisodeResult result = run_episode(robot, controller, options);
   return TeamResult{result.feasible ? result.distance_m : 0.0, result.feasible};
@@ -46,8 +48,9 @@ TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& confi
   const double period_s = config.period_s;
   const int complexity = config.complexity;
   const double duration_s = config.duration_s;
-  return [shared, period_s, complexity, duration_s](const Team& team) {
-    return evaluate_team(*shared, period_s, complexity, duration_s, team);
+  const double dt_s = config.dt_s;
+  return [shared, period_s, complexity, duration_s, dt_s](const Team& team) {
+    return evaluate_team(*shared, period_s, complexity, duration_s, dt_s, team);
   };
 }
 

@@ -22,7 +22,9 @@ Policy team_policy(const Robot& robot, double period_s, int complexity, const Te
 void set_robot(EvolveConfig& config, const Robot& robot);
 
 // One episode of `duration_s` from the settled start. Thread-safe.
-TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, const Team& team);
+// dt_s 0: the robot's own step.
+TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, double dt_s,
+                         const Team& team);
 
 // evaluate_team with the config's episode settings, as a thread-safe function that
 // keeps its own copy of the robot. Throws ConfigError when the robot does not fit the

@@ -17,8 +17,8 @@ Robot parse_checked(const EpisodeSetup& setup) {
 }  // namespace
 
 EpisodeSetup episode_setup(const std::string& robot_json, const EvolveConfig& config) {
-  EpisodeSetup setup{robot_json,      config.robot_hash, config.cables,
-                     config.period_s, config.complexity, config.duration_s};
+  EpisodeSetup setup{robot_json,        config.robot_hash, config.cables, config.period_s,
+                     config.complexity, config.duration_s, config.dt_s};
   // Fail on rank 0, before anything is sent, when the text is not the config's robot.
   (void)parse_checked(setup);
   return setup;
@@ -32,6 +32,7 @@ wire::Setup to_wire(const EpisodeSetup& setup) {
   w.f64(setup.period_s);
   w.u32(static_cast<std::uint32_t>(setup.complexity));
   w.f64(setup.duration_s);
+  w.f64(setup.dt_s);
   const wire::Bytes bytes = w.take();
   return wire::Setup{wire::kProtocol, kEpisodeSetupKind, std::string(bytes.begin(), bytes.end())};
 }
@@ -49,6 +50,7 @@ EpisodeSetup episode_setup_from_wire(const wire::Setup& setup) {
     s.period_s = r.f64();
     s.complexity = static_cast<int>(r.u32());
     s.duration_s = r.f64();
+    s.dt_s = r.f64();
     r.finish();
     return s;
   } catch (const wire::WireError& e) {
@@ -64,6 +66,7 @@ TeamFunction episode_team_function(const EpisodeSetup& setup) {
   config.period_s = setup.period_s;
   config.complexity = setup.complexity;
   config.duration_s = setup.duration_s;
+  config.dt_s = setup.dt_s;
   validate(config);
   return episode_team_function(robot, config);
 }

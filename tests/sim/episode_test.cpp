@@ -82,6 +82,8 @@ TEST(Episode, TensionPastHardLimitIsInfeasibleNotACrash) {
   EXPECT_GT(result.infeasible_time_s, 0.0);
   EXPECT_LT(result.infeasible_time_s, 10.0);
   EXPECT_LT(result.sim_time_s, 10.0);
+  // It ends in the step that broke the limit: a team that scores 0 costs no more.
+  EXPECT_EQ(result.sim_time_s, result.infeasible_time_s);
   EXPECT_EQ(result.distance_m, 0.0);
 }
 

@@ -69,7 +69,7 @@ TEST(Determinism, PhysicsIsTheSameOnOneTwoAndThreeThreads) {
   EXPECT_TRUE(outcomes[0].best.found);
   // The recorded best score is what the policy scores when evaluated again alone.
   const TeamResult again =
-      evaluate_team(robot, config.period_s, config.complexity, config.duration_s, outcomes[0].best.team);
+      evaluate_team(robot, config.period_s, config.complexity, config.duration_s, config.dt_s, outcomes[0].best.team);
   EXPECT_EQ(again.score_m, outcomes[0].best.score_m);
   EXPECT_EQ(again.feasible, outcomes[0].best.feasible);
 }

@@ -116,7 +116,8 @@ EvolveConfig physics_config(const Robot& robot) {
 TEST(EpisodeSetup, RoundTripsAndScoresLikeRankZero) {
   const std::string text = robot_text();
   const Robot robot = parse_robot(text);
-  const EvolveConfig config = physics_config(robot);
+  EvolveConfig config = physics_config(robot);
+  config.dt_s = 0.002;
   const EpisodeSetup sent = episode_setup(text, config);
   const EpisodeSetup got = episode_setup_from_wire(wire::decode_setup(wire::encode(to_wire(sent))));
   EXPECT_EQ(got.robot_json, text);
@@ -125,6 +126,7 @@ TEST(EpisodeSetup, RoundTripsAndScoresLikeRankZero) {
   EXPECT_EQ(bits(got.period_s), bits(config.period_s));
   EXPECT_EQ(got.complexity, config.complexity);
   EXPECT_EQ(bits(got.duration_s), bits(config.duration_s));
+  EXPECT_EQ(bits(got.dt_s), bits(config.dt_s));
 
   Team team;
   for (int c = 0; c < config.cables; ++c) team.rest_lengths_m.push_back({0.8, 0.95 - 0.005 * c, 0.7});
@@ -132,6 +134,10 @@ TEST(EpisodeSetup, RoundTripsAndScoresLikeRankZero) {
   const TeamResult there = episode_team_function(got)(team);
   EXPECT_EQ(bits(there.score_m), bits(here.score_m));
   EXPECT_EQ(there.feasible, here.feasible);
+  EvolveConfig robot_step = config;
+  robot_step.dt_s = 0.0;
+  EXPECT_NE(bits(episode_team_function(robot, robot_step)(team).score_m), bits(here.score_m))
+      << "the team was not scored at the config's step";
 }
 
 TEST(EpisodeSetup, ForeignRobotOrKindIsRefused) {
