@@ -1,22 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "ground/station.hpp"
 
-#include <fastdds/dds/domain/DomainParticipant.hpp>
-#include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/Publisher.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
-#include <fastdds/dds/subscriber/DataReaderListener.hpp>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastdds/dds/subscriber/Subscriber.hpp>
-
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <ctime>
 
-#include "msgs/dds.hpp"
-#include "msgs/endcap_writers.hpp"
-#include "msgs/matched_readers.hpp"
+#include "ground/station_dds.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
@@ -26,98 +15,6 @@
 #include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"
 
 namespace tensegrity::ground {
-
-namespace dds = eprosima::fastdds::dds;
-
-namespace {
-bool valid_endcap(int id) { return id >= 0 && id < kEndcapCount; }
-
-// False, and nothing kept, for a report of a life the end cap has left.
-bool merge_estops(EndcapStatus& e, const fw::comms::EstopCount& heard) {
-  const auto& left = e.left_lives;
-  if (heard.life_id != 0 && std::find(left.begin(), left.end(), heard.life_id) != left.end()) {
-    ++e.stale_life_samples;
-    return false;
-  }
-  if (heard.life_id != e.estops.life_id) {
-    if (e.estops.life_id != 0) {
-      std::copy_backward(e.left_lives.begin(), e.left_lives.end() - 1, e.left_lives.end());
-      e.left_lives[0] = e.estops.life_id;
-    }
-    e.estops = heard;
-  } else if (heard.count > e.estops.count) {
-    e.estops.count = heard.count;
-  }
-  return true;
-}
-}  // namespace
-
-// One listener per reader; each takes its samples in the receive thread.
-struct StationListeners {
-  class Listener final : public dds::DataReaderListener {
-   public:
-    Listener(Station& station, void (*fn)(Station&, dds::DataReader*), const char* topic)
-        : station_(station), fn_(fn), topic_(topic) {}
-    void on_data_available(dds::DataReader* reader) override { fn_(station_, reader); }
-    void on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus&) override {
-      std::fprintf(stderr, "ground: incompatible QoS offered on %s\n", topic_);
-    }
-
-   private:
-    Station& station_;
-    void (*fn_)(Station&, dds::DataReader*);
-    const char* topic_;
-  };
-
-  // True when the writer of `info` publishes for `endcap` (its partition, which the
-  // permissions bind to its identity); else the sample is counted, said now and
-  // then, and must be dropped: an end cap speaking for another.
-  static bool vouched(Station& s, const dds::SampleInfo& info, int endcap, const char* what);
-  static void policy_acks(Station& s, dds::DataReader* r);
-  static void command_acks(Station& s, dds::DataReader* r);
-  static void telemetry(Station& s, dds::DataReader* r);
-  static void heartbeats(Station& s, dds::DataReader* r);
-  static void time_sync(Station& s, dds::DataReader* r);
-};
-
-struct Station::Dds {
-  // Declared first, destroyed last: the participant (deleted in close()) calls it.
-  msgs::EndcapWriters writers;
-  msgs::MatchedReaders policy_readers, command_readers;  // the writers' listeners
-  dds::DomainParticipant* participant = nullptr;
-  dds::Publisher* publisher = nullptr;
-  dds::Subscriber* subscriber = nullptr;
-  dds::DataWriter* policy = nullptr;
-  dds::DataWriter* command = nullptr;
-  dds::DataWriter* heartbeat = nullptr;
-  dds::DataWriter* sync_reply = nullptr;
-  std::vector<std::unique_ptr<StationListeners::Listener>> listeners;
-  std::mutex write_mutex;  // the time-sync reply writer is used from the receive thread
-  // Set (under write_mutex) before anything is deleted: a time-sync request being
-  // answered meanwhile finishes first, a later one is not answered. Without it a
-  // request arriving while a ground tool exited reached through a half-destroyed
-  // object (seen: `tensegrity upload` ending with SIGSEGV after a good upload).
-  bool closed = false;
-
-  ~Dds() { close(); }
-  void close() noexcept {
-    {
-      std::lock_guard lock(write_mutex);
-      closed = true;
-    }
-    msgs::delete_participant(participant);
-    participant = nullptr;
-  }
-  dds::DataWriter* writer(const msgs::TopicSpec& spec, dds::TypeSupport type,
-                          dds::DataWriterListener* listener = nullptr) {
-    return msgs::create_writer(*participant, *publisher, spec, type, listener);
-  }
-  void reader(Station& station, const msgs::TopicSpec& spec, dds::TypeSupport type,
-              void (*fn)(Station&, dds::DataReader*)) {
-    listeners.push_back(std::make_unique<StationListeners::Listener>(station, fn, spec.name));
-    msgs::create_reader(*participant, *subscriber, spec, type, listeners.back().get());
-  }
-};
 
 std::int64_t Station::now_ns() {
   timespec ts{};
@@ -219,8 +116,9 @@ void Station::wait_for_command_acks(std::int64_t deadline_ns) {
 
 std::array<EndcapStatus, kEndcapCount> Station::snapshot() const {
   const std::uint16_t reach = reached();  // its own locks: taken before this station's
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_);
   std::array<EndcapStatus, kEndcapCount> out = status_;
+  lock.unlock();
   for (int e = 0; e < kEndcapCount; ++e) out[static_cast<std::size_t>(e)].reached = (reach & (1U << e)) != 0;
   return out;
 }
@@ -249,7 +147,8 @@ bool Station::wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t dea
     bool ready = (reach & mask) == mask;
     for (int i = 0; i < kEndcapCount && ready; ++i) {
       if ((mask & (1U << i)) == 0) continue;
-      ready = status_[i].seen && (!synced || status_[i].heartbeat.clock_synced());
+      ready = status_[i].seen && (!synced || status_[i].heartbeat.clock_synced()) &&
+              (!options_.publish_heartbeat || !status_[i].heartbeat.host_lost());
     }
     if (ready) return true;
     const std::int64_t wait = deadline_ns - now_ns();
@@ -272,130 +171,6 @@ std::uint64_t Station::impostor_samples() const {
 std::uint64_t Station::time_sync_replies() const {
   std::lock_guard lock(mutex_);
   return sync_replies_;
-}
-
-bool StationListeners::vouched(Station& s, const dds::SampleInfo& info, int endcap, const char* what) {
-  const int writer_endcap = s.dds_->writers.endcap_of(info);
-  if (writer_endcap == endcap && valid_endcap(endcap)) return true;
-  std::lock_guard lock(s.mutex_);
-  if (s.impostor_samples_++ % 1000 == 0) {
-    std::fprintf(stderr, "ground: REFUSED %s claiming end cap %d from a writer of %s%d (not its partition)\n", what,
-                 endcap, writer_endcap < 0 ? "no end cap, " : "end cap ", writer_endcap);
-  }
-  return false;
-}
-
-void StationListeners::policy_acks(Station& s, dds::DataReader* r) {
-  msg::PolicyAck_ ack;
-  dds::SampleInfo info;
-  while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "policy ack")) continue;
-    std::lock_guard lock(s.mutex_);
-    if (ack.format_version() != msgs::kFormatVersion) {
-      std::fprintf(stderr, "ground: REFUSED policy ack from end cap %d: format version %u, we speak %u\n",
-                   int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
-      continue;
-    }
-    if (s.policy_acks_.size() >= Station::kMaxPendingAcks) s.policy_acks_.erase(s.policy_acks_.begin());
-    s.policy_acks_.push_back(ack);
-    s.changed_.notify_all();
-  }
-}
-
-void StationListeners::command_acks(Station& s, dds::DataReader* r) {
-  msg::CommandAck_ ack;
-  dds::SampleInfo info;
-  while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "command ack")) continue;
-    std::lock_guard lock(s.mutex_);
-    if (ack.format_version() != msgs::kFormatVersion) {
-      std::fprintf(stderr, "ground: REFUSED command ack from end cap %d: format version %u, we speak %u\n",
-                   int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
-      continue;
-    }
-    if (s.command_acks_.size() >= Station::kMaxPendingAcks) s.command_acks_.erase(s.command_acks_.begin());
-    s.command_acks_.push_back(ack);
-    s.changed_.notify_all();
-  }
-}
-
-void StationListeners::telemetry(Station& s, dds::DataReader* r) {
-  msg::Telemetry_ t;
-  dds::SampleInfo info;
-  while (r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
-    const std::int64_t now = Station::now_ns();
-    if (!info.valid_data || !vouched(s, info, t.endcap_id(), "telemetry")) continue;
-    std::function<void(const msg::Telemetry_&, std::int64_t)> callback;
-    {
-      std::lock_guard lock(s.mutex_);
-      EndcapStatus& e = s.status_[static_cast<std::size_t>(t.endcap_id())];
-      if (t.format_version() != msgs::kFormatVersion) {
-        if (e.refused++ % 1000 == 0) {
-          std::fprintf(stderr, "ground: REFUSED telemetry from end cap %d: format version %u, we speak %u\n",
-                       int{t.endcap_id()}, unsigned{t.format_version()}, unsigned{msgs::kFormatVersion});
-        }
-        continue;
-      }
-      if (e.have_telemetry && t.seq() > e.telemetry.seq() + 1) e.telemetry_gaps += t.seq() - e.telemetry.seq() - 1;
-      e.have_telemetry = true;
-      e.telemetry = t;
-      e.telemetry_host_ns = now;
-      ++e.telemetry_count;
-      callback = s.telemetry_callback_;
-    }
-    if (callback) callback(t, now);
-  }
-}
-
-void Station::note_estops(int endcap, const fw::comms::EstopCount& heard) {
-  if (endcap < 0 || endcap >= kEndcapCount) return;
-  std::lock_guard lock(mutex_);
-  merge_estops(status_[static_cast<std::size_t>(endcap)], heard);
-}
-
-void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
-  msg::Heartbeat_ hb;
-  dds::SampleInfo info;
-  while (r->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data || !vouched(s, info, hb.source(), "heartbeat")) continue;
-    std::lock_guard lock(s.mutex_);
-    EndcapStatus& e = s.status_[static_cast<std::size_t>(hb.source())];
-    if (hb.format_version() != msgs::kFormatVersion) {
-      if (e.refused++ % 100 == 0) {
-        std::fprintf(stderr, "ground: REFUSED heartbeat from end cap %d: format version %u, we speak %u\n",
-                     int{hb.source()}, unsigned{hb.format_version()}, unsigned{msgs::kFormatVersion});
-      }
-      continue;
-    }
-    if (!merge_estops(e, {hb.life_id(), hb.estops_received()})) continue;
-    e.seen = true;
-    e.heartbeat = hb;
-    e.heartbeat_host_ns = Station::now_ns();
-    s.changed_.notify_all();
-  }
-}
-
-void StationListeners::time_sync(Station& s, dds::DataReader* r) {
-  msg::TimeSyncRequest_ req;
-  dds::SampleInfo info;
-  while (r->take_next_sample(&req, &info) == ReturnCode_t::RETCODE_OK) {
-    const std::int64_t t2 = Station::now_ns();
-    if (!info.valid_data || req.format_version() != msgs::kFormatVersion) continue;
-    if (!vouched(s, info, req.endcap_id(), "time-sync request")) continue;
-    msg::TimeSyncReply_ reply;
-    reply.format_version(msgs::kFormatVersion);
-    reply.endcap_id(req.endcap_id());
-    reply.seq(req.seq());
-    reply.nonce(req.nonce());
-    reply.t1_ns(req.t1_ns());
-    reply.t2_ns(t2);
-    std::lock_guard write_lock(s.dds_->write_mutex);
-    if (s.dds_->closed) return;
-    reply.t3_ns(Station::now_ns());
-    s.dds_->sync_reply->write(&reply);
-    std::lock_guard lock(s.mutex_);
-    ++s.sync_replies_;
-  }
 }
 
 }  // namespace tensegrity::ground

@@ -113,7 +113,10 @@ class Station {
   // writers are matched with: what it writes reaches them (msgs/matched_readers.hpp).
   std::uint16_t reached() const;
   // True once every end cap in `mask` sent a heartbeat (and, with `synced`, says
-  // its clock is synchronized) and is reached; false at the deadline.
+  // its clock is synchronized) and is reached, and, when this station is a host
+  // (publish_heartbeat), hears a host: an end cap that has lost its host stops what
+  // it is told to start (host_lost), and a fresh station's orders can reach it
+  // before its heartbeat does. False at the deadline.
   bool wait_for_endcaps(std::uint16_t mask, bool synced, std::int64_t deadline_ns) const;
   // Called from the DDS receive thread for every valid telemetry sample, with the
   // host clock at arrival. Set before samples are expected; keep it short.

@@ -2,9 +2,10 @@
 // The DDS link end to end with the real firmware: 12 `endcap` programs
 // (firmware/app with its real DDS node, realtime loop on a UDP CAN bus),
 // each with its emulated drives and load cell (endcap_device_sim), and the host
-// side through the `tensegrity` program: upload, start, status --once. An
-// observer Station in this process (no heartbeat of its own) watches telemetry
-// and measures the upload latency to the 12 real end caps.
+// side through the `tensegrity` program: upload, start, status --once, with a
+// console running as the operator's host. An observer Station in this process (no
+// heartbeat of its own) watches telemetry and measures the upload latency to the 12
+// real end caps.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -67,6 +68,7 @@ class RealEndcaps : public ::testing::Test {
     }
     endcaps_.clear();
     devices_.clear();
+    console_.reset();
     observer_.reset();
     if (HasFailure()) {
       for (int e = 0; e < kEndcapCount; ++e) {
@@ -157,6 +159,7 @@ class RealEndcaps : public ::testing::Test {
   std::vector<std::unique_ptr<Subprocess>> devices_;
   std::vector<std::unique_ptr<Subprocess>> endcaps_;
   std::unique_ptr<Station> observer_;
+  std::unique_ptr<Subprocess> console_;
 };
 
 TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
@@ -164,11 +167,19 @@ TEST_F(RealEndcaps, TwelveEndcapProcessesTakeAnUploadStartAndStreamTelemetry) {
   StationOptions o;
   o.domain = kDomain;
   o.name = "e2e_observer";
-  o.publish_heartbeat = false;  // an observer: the CLI is the host
+  o.publish_heartbeat = false;  // an observer: the operator's console is the host
   observer_ = std::make_unique<Station>(o);
   const std::int64_t t0 = Station::now_ns();
   ASSERT_TRUE(observer_->wait_for_endcaps(kAllEndcaps, false, t0 + 20'000'000'000))
       << "not every end cap's DDS node came up: " << seen_text();
+  // The end caps stop, latched, once no host is heard (host_lost): `upload` and `start`
+  // exit, so the operator's console keeps the host heartbeat, as on the robot.
+  console_ = std::make_unique<Subprocess>(
+      std::vector<std::string>{TENSEGRITY_CLI, "console", "--insecure", "--domain", std::to_string(kDomain), "--socket",
+                               (dir_ / "console" / "console.sock").string()},
+      dir_ / "console.out", dir_ / "console.err", "/dev/null");
+  ASSERT_TRUE(console_->wait_for_output("hears 12 of 12", std::chrono::seconds(30)))
+      << console_->output() << read(dir_ / "console.err");
   std::printf("MEASURE discovery of 12 end-cap processes: %.0f ms\n",
               static_cast<double>(Station::now_ns() - t0) / 1e6);
 

@@ -57,6 +57,12 @@ TEST(StatusFormat, ShowsOnlyTheExpectedEndcapsAndNamesTheMissingOnes) {
   EXPECT_EQ(json::parse(format_status_json(status, 0))["endcaps"].size(), 12U);
 }
 
+// The table's row of end cap `e` (rows start with the id right-aligned in 6 columns).
+std::string table_row(const std::string& table, int e) {
+  const std::size_t at = table.find("\n     " + std::to_string(e) + " ");
+  return table.substr(at + 1, table.find('\n', at + 1) - at - 1);
+}
+
 TEST(StatusFormat, AnEndcapNotHeardLatelyIsMarkedSilentNotShownAsItWas) {
   auto status = seen({0, 1});
   const std::int64_t now_ns = 10'000'000'000;
@@ -65,10 +71,7 @@ TEST(StatusFormat, AnEndcapNotHeardLatelyIsMarkedSilentNotShownAsItWas) {
   EXPECT_EQ(silent_endcaps(status, now_ns, 0b11), std::vector<int>{1});
   EXPECT_TRUE(silent_endcaps(status, now_ns, 0b01).empty()) << "only the expected ones";
   const std::string table = format_status_table(status, now_ns, 0b11);
-  const auto row = [&](int e) {
-    const std::size_t at = table.find("\n     " + std::to_string(e) + " ");
-    return table.substr(at + 1, table.find('\n', at + 1) - at - 1);
-  };
+  const auto row = [&table](int e) { return table_row(table, e); };
   EXPECT_EQ(row(0).find("SILENT"), std::string::npos) << table;
   EXPECT_NE(row(1).find("SILENT"), std::string::npos) << table;
   const json j = json::parse(format_status_json(status, now_ns, 0b11));
@@ -147,10 +150,7 @@ TEST(StatusFormat, AnEndcapHeardButNotReachedIsMarked) {
   status[0].heartbeat_host_ns = status[1].heartbeat_host_ns = now_ns;
   status[0].reached = true;
   const std::string table = format_status_table(status, now_ns, 0b11);
-  const auto row = [&](int e) {
-    const std::size_t at = table.find("\n     " + std::to_string(e) + " ");
-    return table.substr(at + 1, table.find('\n', at + 1) - at - 1);
-  };
+  const auto row = [&table](int e) { return table_row(table, e); };
   EXPECT_EQ(row(0).find("UNREACHED"), std::string::npos) << table;
   EXPECT_NE(row(1).find("UNREACHED"), std::string::npos) << table;
   const json j = json::parse(format_status_json(status, now_ns, 0b11));

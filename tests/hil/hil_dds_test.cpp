@@ -247,7 +247,7 @@ TEST(HilDds, LinkCutWithStopStopsTheGait) {
     EXPECT_EQ(e.link_cuts, 1U) << "end cap " << e.endcap;
     EXPECT_GE(e.host_losses, 1U) << "end cap " << e.endcap;
     EXPECT_FALSE(e.playing) << "end cap " << e.endcap << " still playing after losing the host";
-    EXPECT_EQ(e.fault, "host_lost") << "the stop is latched until cleared: end cap " << e.endcap;
+    EXPECT_EQ(e.fault, "host link lost") << "the stop is latched until cleared: end cap " << e.endcap;
   }
   EXPECT_EQ(r.playing, 0);
   ASSERT_EQ(distance_by_s.size(), 40u);
