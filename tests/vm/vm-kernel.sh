@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # SPDX-License-Identifier: Apache-2.0
 # Sourced by the VM tests (run-vcan-vm.sh, power-cut.sh): Debian's own amd64 kernel,
 # downloaded once into a cache, and a busybox initramfs that loads the modules a
@@ -116,7 +117,7 @@ vm_kernel() {
   [[ -f "$VM_KDIR/.complete" ]] && kept=" $(cat "$VM_KDIR/.complete") "
   for m in "$@"; do [[ "$kept" == *" $m "* ]] || missing=1; done
   if [[ -z "$kept" || $missing -eq 1 ]]; then
-    # shellcheck disable=SC2086  # kept is a space-separated module list
+    # shellcheck disable=SC2086,SC2046  # module names: one word each
     _vm_fetch_kernel "$cache" $(printf '%s\n' $kept "$@" | awk '!seen[$0]++')
   fi
   _vm_resolve_all "$@" || { flock -u 9; skip "kernel $kernel lacks a module of: $*"; }
