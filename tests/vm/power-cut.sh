@@ -128,7 +128,9 @@ marks() {  # the complete "PC ..." lines of console $1 (a torn last line never h
 
 wait_for() {  # wait_for LOG PATTERN: until the console has it; 1 if qemu ended first
   local deadline=$((SECONDS + timeout_s))
-  while ! text "$1" | grep -aq "$2"; do
+  # One grep a poll, on the raw console: the lines waited for never follow an escape,
+  # and a heavier poll took CPU from the VM on a loaded machine.
+  while ! grep -aq "$2" "$1"; do
     kill -0 "$qpid" 2>/dev/null || return 1
     ((SECONDS < deadline)) || return 1
     sleep 0.02
