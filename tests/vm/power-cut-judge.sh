@@ -72,7 +72,7 @@ summary() {
   line=""
   for o in old new lost mixed missing unexpected; do line+=" $o ${pc_count[$o]:-0},"; done
   echo "  outcomes:${line%,}; slots failing FileStorage's check after ${pc_count[bad_slots]:-0} cut(s)"
-  echo "  file system after the last boot (e2fsck -fn): $2; $1 s"
+  echo "  file system after the last boot (e2fsck -fn): $2; boots retried (the kernel died before the store): $pc_retries; $1 s"
   if ((pc_failed > 0)); then
     echo "power-cut: FAILED: $pc_failed of $cuts cuts did not leave a whole old or new record (${out}/cuts.tsv)"
     return 1
