@@ -45,109 +45,18 @@ if ! file -b "$binary" 2>/dev/null | grep -q 'x86-64.*statically linked\|x86-64.
   command -v file >/dev/null && { echo "run-vcan-vm: $binary is not a static x86_64 executable" >&2; exit 2; }
 fi
 
-# --- host tools --------------------------------------------------------------------
-need_tools() {
-  command -v qemu-system-x86_64 >/dev/null && [[ -x /bin/busybox ]] &&
-    file -b /bin/busybox | grep -q 'statically linked' &&
-    command -v cpio >/dev/null && command -v xz >/dev/null && command -v zstd >/dev/null
-}
-if ! need_tools && [[ $install -eq 1 && $(id -u) -eq 0 ]]; then
-  "$root/scripts/setup-cross.sh" "$here/debian-packages-vm.txt" >&2 || true
-fi
-need_tools || skip "needs qemu-system-x86_64, busybox-static, cpio, xz and zstd (scripts/setup-cross.sh $here/debian-packages-vm.txt)"
-
-# --- kernel: Debian's linux-image-<abi>, downloaded once into the cache ----------------
-mkdir -p "$cache"
-exec 9>"$cache/.lock"
-flock 9   # parallel runs share one cache
-
-# A kernel already in the cache wins (no apt query: it takes seconds here); else
-# the one Debian's linux-image-amd64 currently depends on.
-if [[ -z "$kernel" ]]; then
-  kernel="$(cd "$cache" && ls -1d kernel-*/.complete 2>/dev/null |
-    sed -n 's|^kernel-\(.*\)/\.complete$|\1|p' | sort -V | tail -n1 || true)"
-fi
-if [[ -z "$kernel" ]]; then
-  kernel="$(apt-cache depends linux-image-amd64 2>/dev/null |
-    sed -n 's/^ *Depends: linux-image-\([0-9].*-amd64\)$/\1/p' | head -n1 || true)"
-fi
-[[ -n "$kernel" ]] || skip "cannot tell which kernel to use (apt-get update, or --kernel ABI)"
-
-kdir="$cache/kernel-$kernel"
-moddir="$kdir/lib/modules/$kernel"
-wanted=(can can-raw can-dev vcan)   # what SocketCAN over vcan needs
-
-declare -A seen=()
-order=()
-dep_line() {  # the modules.dep line of module $1 (file name without .ko*)
-  grep -E "(^|/)$1\.ko(\.xz|\.zst|\.gz)?:" "$moddir/modules.dep" | head -n1
-}
-resolve() {  # appends module $1's dependencies, then $1, to order (paths in moddir)
-  local name="$1" line path dep
-  [[ -n "${seen[$name]:-}" ]] && return 0
-  seen[$name]=1
-  line="$(dep_line "$name")"
-  if [[ -z "$line" ]]; then
-    # Built into the kernel: nothing to load.
-    grep -qE "(^|/)$name\.ko$" "$moddir/modules.builtin" 2>/dev/null && return 0
-    log "module $name not found in $moddir/modules.dep"; return 1
-  fi
-  path="${line%%:*}"
-  for dep in ${line#*:}; do
-    dep="$(basename "$dep")"; resolve "${dep%%.ko*}" || return 1
-  done
-  order+=("$path")
-}
-
-if [[ "$(cat "$kdir/.complete" 2>/dev/null)" != "${wanted[*]}" ]]; then
-  log "fetching linux-image-$kernel (once; cached in $kdir)"
-  rm -rf "$kdir" "$kdir.tmp" "$cache/dl"; mkdir -p "$cache/dl"
-  if ! (cd "$cache/dl" && apt-get download -qq "linux-image-$kernel" >/dev/null 2>&1); then
-    if [[ $(id -u) -eq 0 ]]; then apt-get update -qq >/dev/null 2>&1 || true; fi
-    (cd "$cache/dl" && apt-get download -qq "linux-image-$kernel" >/dev/null 2>&1) ||
-      { rm -rf "$cache/dl"; skip "apt-get download linux-image-$kernel failed"; }
-  fi
-  dpkg-deb -x "$cache"/dl/linux-image-"$kernel"_*.deb "$kdir.tmp"
-  rm -rf "$cache/dl"
-  mkdir -p "$kdir/lib"
-  cp "$kdir.tmp/boot/vmlinuz-$kernel" "$kdir/vmlinuz"
-  mv "$kdir.tmp/lib/modules" "$kdir/lib/modules"
-  rm -rf "$kdir.tmp"
-  # The package ships no modules.dep (its postinst runs depmod): make one.
-  if [[ ! -f "$moddir/modules.dep" ]]; then
-    command -v depmod >/dev/null || PATH="$PATH:/usr/sbin:/sbin"
-    command -v depmod >/dev/null || { rm -rf "$kdir"; skip "needs depmod (Debian package kmod)"; }
-    depmod -b "$kdir" "$kernel"
-  fi
-  for m in "${wanted[@]}"; do resolve "$m" || { rm -rf "$kdir"; skip "kernel $kernel lacks module $m"; }; done
-  # Keep only the modules the VM loads (about 400 MB otherwise).
-  keep="$(printf '%s\n' "${order[@]}")"
-  (cd "$moddir" && find kernel -type f -name '*.ko*' | grep -vxF "$keep" | xargs -r rm -f)
-  find "$moddir/kernel" -depth -type d -empty -delete
-  echo "${wanted[*]}" >"$kdir/.complete"
-else
-  for m in "${wanted[@]}"; do resolve "$m" || skip "kernel $kernel lacks module $m"; done
-fi
-[[ -f "$kdir/vmlinuz" ]] || skip "kernel cache $kdir is incomplete"
-
-# --- initramfs ------------------------------------------------------------------------
+# shellcheck source=tests/vm/vm-kernel.sh
+source "$here/vm-kernel.sh"
+vm_need_tools "$here/debian-packages-vm.txt" "$install"
 work="$(mktemp -d "${TMPDIR:-/tmp}/vcan-vm.XXXXXX")"
 cleanup() { [[ -n "${qpid:-}" ]] && kill "$qpid" 2>/dev/null; rm -rf "$work"; }
 trap cleanup EXIT
+vm_kernel "$cache" "$kernel" "$work/kernel" can can-raw can-dev vcan   # what SocketCAN over vcan needs
+order=("${VM_ORDER[@]}")
+
+# --- initramfs ------------------------------------------------------------------------
 ird="$work/root"
-mkdir -p "$ird"/{bin,sbin,usr/bin,usr/sbin,proc,sys,dev,tmp,modules}
-cp /bin/busybox "$ird/bin/busybox"
-: >"$ird/modules/order"
-for path in "${order[@]}"; do
-  base="$(basename "$path")"; out="$ird/modules/${base%%.ko*}.ko"
-  case "$path" in   # the busybox insmod may lack decompression: decompress here
-    *.ko.xz) xz -dc "$moddir/$path" >"$out" ;;
-    *.ko.zst) zstd -qdc "$moddir/$path" >"$out" ;;
-    *.ko.gz) gzip -dc "$moddir/$path" >"$out" ;;
-    *) cp "$moddir/$path" "$out" ;;
-  esac
-  echo "${base%%.ko*}.ko" >>"$ird/modules/order"
-done
+vm_initramfs_root "$ird" "$work/kernel"
 # Debug info only slows the VM's loading of the initramfs.
 strip -o "$ird/test" "$binary" 2>/dev/null || cp "$binary" "$ird/test"
 printf '%s\n' "${test_args[@]+"${test_args[@]}"}" >"$ird/test.args"
@@ -181,16 +90,16 @@ sync
 poweroff -f
 EOF
 chmod +x "$ird/init"
-(cd "$ird" && find . | LC_ALL=C sort | cpio -o -H newc --quiet | gzip -1) >"$work/initrd.gz"
+vm_pack_initramfs "$ird" "$work/initrd.gz"
 
 # --- boot -----------------------------------------------------------------------------
-log "booting $kernel with ${#order[@]} module(s): ${order[*]##*/}"
+log "booting $VM_KERNEL with ${#order[@]} module(s): ${order[*]##*/}"
 start=$(date +%s.%N)
 out="$work/console.log"
 set +e
 timeout --kill-after=5 "$timeout_s" qemu-system-x86_64 -nographic -no-reboot -m 256 \
   -accel tcg -cpu max -smp 1 -net none -monitor none -serial stdio -display none \
-  -kernel "$kdir/vmlinuz" -initrd "$work/initrd.gz" \
+  -kernel "$work/kernel/vmlinuz" -initrd "$work/initrd.gz" \
   -append 'console=ttyS0 panic=-1 quiet' </dev/null >"$out" 2>&1 &
 qpid=$!
 wait "$qpid"; qrc=$?
