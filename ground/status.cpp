@@ -32,6 +32,7 @@ const char* fault_name(std::uint8_t fault) {
     case core::FaultCause::drive_disabled: return "drive_disabled";
     case core::FaultCause::stale_position: return "stale_position";
     case core::FaultCause::loop_stalled: return "loop_stalled";
+    case core::FaultCause::node_not_operational: return "node_not_operational";
   }
   return "?";
 }
