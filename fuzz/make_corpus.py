@@ -150,7 +150,8 @@ def scenarios():
     params = {"drive_fault": {"motor": 1, "code": 0x2310, "release": True}, "drive_silent": {"motor": -1},
               "load_cell_drift": {"n_per_s": 5.0}, "drop_frames": {"probability": 0.2, "duration_s": 1.5},
               "corrupt_frames": {"probability": 0.1, "duration_s": 0, "kind": "datagram"},
-              "release_spool": {"motor": 0}, "seize_spool": {"motor": 1}, "reboot_drive": {"motor": 0}}
+              "release_spool": {"motor": 0}, "seize_spool": {"motor": 1}, "reboot_drive": {"motor": 0},
+              "drive_preoperational": {"motor": 1}}
     events = []
     for k, name in enumerate(names):
         ev = {"time_s": 0.5 * k, "endcap": k % 12, "fault": name}

@@ -40,7 +40,7 @@ class SimNode {
   virtual ~SimNode() = default;
 
   // Power on: send boot-up, enter pre-operational. The communication objects
-  // (0x1016) are back at their power-on values: not configured.
+  // (0x1016, 0x1017) are back at their power-on values: not configured.
   void boot(std::int64_t now_ns, FrameOut& out);
   // A power cycle (brown-out, watchdog reset): application state reset, then boot.
   void reboot(std::int64_t now_ns, FrameOut& out);
