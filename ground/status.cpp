@@ -130,10 +130,12 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
     }
     endcaps.push_back(j);
   }
+  // The policy ids are the end caps' bytes: one that is not UTF-8 is shown replaced
+  // (U+FFFD) instead of throwing out of `tensegrity status --json`.
   return nlohmann::json{{"endcaps", endcaps},
                         {"missing", missing_endcaps(status, expected)},
                         {"silent", silent_endcaps(status, now_ns, expected)}}
-      .dump(2);
+      .dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace tensegrity::ground
