@@ -54,16 +54,17 @@ def time_sync_reply(nonce, t1, t2, t3, endcap=3):
 
 
 def time_sync_runs():
-    """The end cap's host heartbeat, and runs of time-sync events (op byte, u16
-    time step in us, for a reply a length byte and the sample); op 0x81 and up echo
-    an outstanding request's nonce."""
+    """The end cap's host heartbeat, and runs of time-sync events: op byte (bits
+    0-1: 0 request, 1 reply, 2-3 settle; a reply with bit 7 set echoes the nonce of
+    request slot bits 2-4), u16 time step in us, for a reply a length byte and the
+    sample."""
     out("endcap_time_sync", "host-heartbeat", b"\x00" + heartbeat())
     reply = time_sync_reply(0, 1_000_000_000, 5_000_000_000, 5_000_100_000)
     ops = b""
     for k in range(3):
         ops += b"\x00" + struct.pack("<H", 1000)                                       # request
         ops += bytes([0x81 | (k << 2)]) + struct.pack("<H", 2000) + bytes([len(reply)]) + reply
-    ops += b"\x02" + struct.pack("<H", 60000) + b"\x02" + struct.pack("<H", 60000)        # settle
+    ops += (b"\x02" + struct.pack("<H", 65000)) * 10  # settle: past max_round_trip + max_host_hold
     out("endcap_time_sync", "three-exchanges", b"\x01" + ops)
     out("endcap_time_sync", "unknown-nonce", b"\x01\x01\x10\x00" + bytes([len(reply)]) + reply)
 
@@ -168,11 +169,12 @@ def endcap_stats():
 
 def mt19937_64_state(seed):
     """std::mt19937_64's text form right after seeding: its 312 words (the
-    standard's initialisation), as operator<< writes them."""
+    standard's initialisation), then libstdc++'s position in them, as operator<<
+    writes them."""
     x = [seed & (2**64 - 1)]
     for i in range(1, 312):
         x.append((6364136223846793005 * (x[-1] ^ (x[-1] >> 62)) + i) & (2**64 - 1))
-    return " ".join(str(v) for v in x)
+    return " ".join(str(v) for v in x + [312])
 
 
 def checkpoints():

@@ -48,7 +48,7 @@ void run_time_sync(Input in) {
   while (in.left > 0) {
     const auto op = in.take<std::uint8_t>();
     now += in.take<std::uint16_t>() * 1'000;  // time only moves forward, as the node's clock does
-    switch (op % 3) {
+    switch (op & 3U) {                        // bits 2-4: which outstanding nonce a steered reply echoes
       case 0: nonces[sent++ % nonces.size()] = client.start_request(now); break;
       case 1: {
         const std::size_t length = in.take<std::uint8_t>();
@@ -60,7 +60,7 @@ void run_time_sync(Input in) {
         if (!decoded || reply.endcap_id() != kEndcap || reply.format_version() != tensegrity::msgs::kFormatVersion) {
           break;  // the node drops these before the client
         }
-        const std::uint64_t nonce = (op & 0x80U) != 0 ? nonces[(op >> 2) % nonces.size()] : reply.nonce();
+        const std::uint64_t nonce = (op & 0x80U) != 0 ? nonces[(op >> 2U) % nonces.size()] : reply.nonce();
         (void)client.on_reply(nonce, reply.t2_ns(), reply.t3_ns(), now);
         break;
       }
