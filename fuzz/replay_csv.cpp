@@ -5,7 +5,6 @@
 // scratch file first.
 #include <unistd.h>
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -36,18 +35,17 @@ const std::filesystem::path& scratch_file() {
   return path;
 }
 
-// Every frame kept is whole and in time order, with finite numbers only: the page
-// draws them as they are.
+// Every frame kept is whole and in time order. Values need not be finite once kept
+// as floats: a diverged simulation writes huge positions, which the page is given as
+// null (json_numbers.hpp) rather than the file refused.
 void check(const view::ReplayFrames& f) {
   const std::size_t n = f.frames();
   if (f.node_m.size() != n * static_cast<std::size_t>(f.nodes) * 3) std::abort();
   if (f.rest_length_m.size() != n * static_cast<std::size_t>(f.cables)) std::abort();
   if (f.tension_n.size() != n * static_cast<std::size_t>(f.cables)) std::abort();
+  if (f.has_energy && f.energy_j.size() != n * 3) std::abort();
   for (std::size_t i = 1; i < n; ++i) {
     if (!(f.time_s[i] >= f.time_s[i - 1])) std::abort();
-  }
-  for (double v : f.node_m) {
-    if (!std::isfinite(v)) std::abort();
   }
 }
 
