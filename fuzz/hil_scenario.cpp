@@ -51,6 +51,7 @@ bool takes_no_params(hil::FaultKind kind) {
     case hil::FaultKind::release_spool:
     case hil::FaultKind::seize_spool:
     case hil::FaultKind::reboot_drive:
+    case hil::FaultKind::drive_preoperational:
     case hil::FaultKind::load_cell_drift:
     case hil::FaultKind::drop_frames:
     case hil::FaultKind::corrupt_frames: return false;

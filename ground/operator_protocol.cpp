@@ -107,7 +107,7 @@ std::string encode_reply(const OperatorReply& reply) {
               {"rejoins", reply.report.rejoins},
               {"preempted", reply.report.preempted},
               {"results", results}}
-      .dump();
+      .dump(-1, ' ', false, json::error_handler_t::replace);  // ack texts: the end caps' bytes, maybe not UTF-8
 }
 
 OperatorReply decode_reply(const std::string& line) {

@@ -2,9 +2,8 @@
 // What arrives from the end caps, in the receive thread: each sample checked (its
 // writer's partition vouches for the end cap it names, this format version) before
 // the station keeps it.
-#include <algorithm>
-
 #include "ground/station_dds.hpp"
+#include "ground/station_samples.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "tensegrity_msgs/msg/PolicyAckPubSubTypes.h"
@@ -12,29 +11,6 @@
 #include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"
 
 namespace tensegrity::ground {
-
-namespace {
-bool valid_endcap(int id) { return id >= 0 && id < kEndcapCount; }
-
-// False, and nothing kept, for a report of a life the end cap has left.
-bool merge_estops(EndcapStatus& e, const fw::comms::EstopCount& heard) {
-  const auto& left = e.left_lives;
-  if (heard.life_id != 0 && std::find(left.begin(), left.end(), heard.life_id) != left.end()) {
-    ++e.stale_life_samples;
-    return false;
-  }
-  if (heard.life_id != e.estops.life_id) {
-    if (e.estops.life_id != 0) {
-      std::copy_backward(e.left_lives.begin(), e.left_lives.end() - 1, e.left_lives.end());
-      e.left_lives[0] = e.estops.life_id;
-    }
-    e.estops = heard;
-  } else if (heard.count > e.estops.count) {
-    e.estops.count = heard.count;
-  }
-  return true;
-}
-}  // namespace
 
 bool StationListeners::vouched(Station& s, const dds::SampleInfo& info, int endcap, const char* what) {
   const int writer_endcap = s.dds_->writers.endcap_of(info);
@@ -53,7 +29,7 @@ void StationListeners::policy_acks(Station& s, dds::DataReader* r) {
   while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "policy ack")) continue;
     std::lock_guard lock(s.mutex_);
-    if (ack.format_version() != msgs::kFormatVersion) {
+    if (check_ack(ack.format_version()) != SampleVerdict::taken) {
       std::fprintf(stderr, "ground: REFUSED policy ack from end cap %d: format version %u, we speak %u\n",
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
@@ -70,7 +46,7 @@ void StationListeners::command_acks(Station& s, dds::DataReader* r) {
   while (r->take_next_sample(&ack, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data || !vouched(s, info, ack.endcap_id(), "command ack")) continue;
     std::lock_guard lock(s.mutex_);
-    if (ack.format_version() != msgs::kFormatVersion) {
+    if (check_ack(ack.format_version()) != SampleVerdict::taken) {
       std::fprintf(stderr, "ground: REFUSED command ack from end cap %d: format version %u, we speak %u\n",
                    int{ack.endcap_id()}, unsigned{ack.format_version()}, unsigned{msgs::kFormatVersion});
       continue;
@@ -91,18 +67,13 @@ void StationListeners::telemetry(Station& s, dds::DataReader* r) {
     {
       std::lock_guard lock(s.mutex_);
       EndcapStatus& e = s.status_[static_cast<std::size_t>(t.endcap_id())];
-      if (t.format_version() != msgs::kFormatVersion) {
-        if (e.refused++ % 1000 == 0) {
+      if (take_telemetry(e, t, now) != SampleVerdict::taken) {
+        if (e.refused % 1000 == 1) {
           std::fprintf(stderr, "ground: REFUSED telemetry from end cap %d: format version %u, we speak %u\n",
                        int{t.endcap_id()}, unsigned{t.format_version()}, unsigned{msgs::kFormatVersion});
         }
         continue;
       }
-      if (e.have_telemetry && t.seq() > e.telemetry.seq() + 1) e.telemetry_gaps += t.seq() - e.telemetry.seq() - 1;
-      e.have_telemetry = true;
-      e.telemetry = t;
-      e.telemetry_host_ns = now;
-      ++e.telemetry_count;
       callback = s.telemetry_callback_;
     }
     if (callback) callback(t, now);
@@ -122,18 +93,12 @@ void StationListeners::heartbeats(Station& s, dds::DataReader* r) {
     if (!info.valid_data || !vouched(s, info, hb.source(), "heartbeat")) continue;
     std::lock_guard lock(s.mutex_);
     EndcapStatus& e = s.status_[static_cast<std::size_t>(hb.source())];
-    if (hb.format_version() != msgs::kFormatVersion) {
-      if (e.refused++ % 100 == 0) {
-        std::fprintf(stderr, "ground: REFUSED heartbeat from end cap %d: format version %u, we speak %u\n",
-                     int{hb.source()}, unsigned{hb.format_version()}, unsigned{msgs::kFormatVersion});
-      }
-      continue;
+    const SampleVerdict verdict = take_heartbeat(e, hb, Station::now_ns());
+    if (verdict == SampleVerdict::wrong_format && e.refused % 100 == 1) {
+      std::fprintf(stderr, "ground: REFUSED heartbeat from end cap %d: format version %u, we speak %u\n",
+                   int{hb.source()}, unsigned{hb.format_version()}, unsigned{msgs::kFormatVersion});
     }
-    if (!merge_estops(e, {hb.life_id(), hb.estops_received()})) continue;
-    e.seen = true;
-    e.heartbeat = hb;
-    e.heartbeat_host_ns = Station::now_ns();
-    s.changed_.notify_all();
+    if (verdict == SampleVerdict::taken) s.changed_.notify_all();
   }
 }
 

@@ -32,6 +32,7 @@ const char* fault_name(std::uint8_t fault) {
     case core::FaultCause::drive_disabled: return "drive_disabled";
     case core::FaultCause::stale_position: return "stale_position";
     case core::FaultCause::loop_stalled: return "loop_stalled";
+    case core::FaultCause::node_not_operational: return "node_not_operational";
   }
   return "?";
 }
@@ -129,10 +130,12 @@ std::string format_status_json(const std::array<EndcapStatus, kEndcapCount>& sta
     }
     endcaps.push_back(j);
   }
+  // The policy ids are the end caps' bytes: one that is not UTF-8 is shown replaced
+  // (U+FFFD) instead of throwing out of `tensegrity status --json`.
   return nlohmann::json{{"endcaps", endcaps},
                         {"missing", missing_endcaps(status, expected)},
                         {"silent", silent_endcaps(status, now_ns, expected)}}
-      .dump(2);
+      .dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace tensegrity::ground

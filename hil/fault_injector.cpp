@@ -56,7 +56,11 @@ void FaultInjector::apply(const ScenarioEvent& ev, std::int64_t step, std::int64
     case FaultKind::load_cell_drift: target.devices(e).start_load_cell_drift(ev.params.n_per_s, now_ns); break;
     case FaultKind::drop_frames:
     case FaultKind::corrupt_frames: start_frame_fault(ev, step, target); break;
-    case FaultKind::reboot_drive: apply_to_motors(ev, now_ns, target); break;
+    case FaultKind::reboot_drive:
+    case FaultKind::drive_preoperational: apply_to_motors(ev, now_ns, target); break;
+    case FaultKind::load_cell_stopped:
+      target.devices(e).load_cell().leave_operational(canopen::NmtState::stopped);
+      break;
     case FaultKind::reboot_load_cell:
       target.devices(e).reboot_load_cell(now_ns, out_);
       target.send(e, out_);  // the boot-up, ahead of this tick's PDOs
@@ -87,6 +91,9 @@ void FaultInjector::apply_to_motors(const ScenarioEvent& ev, std::int64_t now_ns
       case FaultKind::release_spool: devices.release_spool(m); break;
       case FaultKind::seize_spool: devices.seize_spool(m); break;
       case FaultKind::reboot_drive: devices.reboot_drive(m, now_ns, out_); break;
+      case FaultKind::drive_preoperational:
+        devices.drive(m).leave_operational(canopen::NmtState::pre_operational);
+        break;
       default: break;
     }
   }

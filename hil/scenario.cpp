@@ -16,7 +16,7 @@ namespace tensegrity::hil {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 17> kNames{{
+constexpr std::array<std::pair<FaultKind, const char*>, 19> kNames{{
     {FaultKind::drive_fault, "drive_fault"},
     {FaultKind::drive_silent, "drive_silent"},
     {FaultKind::load_cell_stuck, "load_cell_stuck"},
@@ -31,6 +31,8 @@ constexpr std::array<std::pair<FaultKind, const char*>, 17> kNames{{
     {FaultKind::seize_spool, "seize_spool"},
     {FaultKind::reboot_drive, "reboot_drive"},
     {FaultKind::reboot_load_cell, "reboot_load_cell"},
+    {FaultKind::drive_preoperational, "drive_preoperational"},
+    {FaultKind::load_cell_stopped, "load_cell_stopped"},
     {FaultKind::hang_loop, "hang_loop"},
     {FaultKind::stop_endcap, "stop_endcap"},
     {FaultKind::mute_dds, "mute_dds"},
@@ -60,7 +62,8 @@ std::vector<std::string> params_of(FaultKind kind) {
     case FaultKind::drive_silent:
     case FaultKind::release_spool:
     case FaultKind::seize_spool:
-    case FaultKind::reboot_drive: return {"motor"};
+    case FaultKind::reboot_drive:
+    case FaultKind::drive_preoperational: return {"motor"};
     case FaultKind::load_cell_drift: return {"n_per_s"};
     case FaultKind::drop_frames: return {"probability", "duration_s"};
     case FaultKind::corrupt_frames: return {"probability", "duration_s", "kind"};
@@ -149,6 +152,7 @@ std::string ScenarioEvent::describe() const {
       break;
     case FaultKind::drive_silent:
     case FaultKind::reboot_drive:
+    case FaultKind::drive_preoperational:
     case FaultKind::release_spool:
     case FaultKind::seize_spool: s << " (motor " << params.motor << ")"; break;
     case FaultKind::load_cell_drift: s << " (" << params.n_per_s << " N/s)"; break;

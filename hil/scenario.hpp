@@ -33,10 +33,14 @@ enum class FaultKind : std::uint8_t {
   // CANopen supervision (docs/design/canopen.md):
   reboot_drive,      // the drive power-cycles: boot-up, pre-operational, unpowered; params: motor
   reboot_load_cell,  // the load cell power-cycles
-  hang_loop,         // the end cap's control loop hangs, its process (DDS node) lives (test hook)
-  stop_endcap,       // SIGSTOP: a dead end cap; its drives find out through their heartbeat consumer
-  mute_dds,          // the end cap's DDS participant stops sending, for good, and still hears (a handshake
-                     // stalled one way); its rejoin clears it; no endcap: all
+  // The node leaves NMT operational by itself and goes on beating (pre-operational /
+  // stopped): no PDOs either way, no boot-up. drive_preoperational params: motor.
+  drive_preoperational,
+  load_cell_stopped,
+  hang_loop,    // the end cap's control loop hangs, its process (DDS node) lives (test hook)
+  stop_endcap,  // SIGSTOP: a dead end cap; its drives find out through their heartbeat consumer
+  mute_dds,     // the end cap's DDS participant stops sending, for good, and still hears (a handshake
+                // stalled one way); its rejoin clears it; no endcap: all
 };
 
 const char* to_string(FaultKind kind);

@@ -198,7 +198,7 @@ std::string LiveBridge::status_json() const {
                         {"frame_rate_hz", options_.frame_rate_hz},
                         {"superseded", superseded_},
                         {"endcaps", endcaps}}
-      .dump();
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // policy ids: the end caps' bytes
 }
 
 void LiveBridge::status_loop() {

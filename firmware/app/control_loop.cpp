@@ -30,6 +30,7 @@ bool quick_stops(FaultCause c) {
     case FaultCause::emergency_stop:
     case FaultCause::node_rebooted:
     case FaultCause::loop_stalled:
+    case FaultCause::node_not_operational:
     case FaultCause::drive_disabled: return true;
     default: return false;
   }
@@ -252,7 +253,9 @@ void ControlLoop::cycle(std::int64_t time_ns, double dt_s) {
   }
   handle_host(time_ns);
 
-  const bool armed = master_.bring_up_step() == BringUpStep::done;
+  // A clear that found a node out of operational asked for a new bring-up (next
+  // cycle): until that is done the node is expected to be out of operational.
+  const bool armed = bring_up_started_ && master_.bring_up_step() == BringUpStep::done;
   latch(safety_.check(master_, time_ns, armed), time_ns);
   // A stop latched before or during a bring-up outlasts it: the bring-up's own
   // request to enable the drives must not undo an operator's stop.

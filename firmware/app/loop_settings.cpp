@@ -20,6 +20,12 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   s.master.use_load_cell = c.use_load_cell;
   s.master.drive_heartbeat_timeout_ns = core::seconds_to_ns(c.drive_heartbeat_timeout_s);
   s.master.load_cell_heartbeat_timeout_ns = core::seconds_to_ns(c.load_cell_heartbeat_timeout_s);
+  // Each node beats five times per heartbeat timeout (the shorter of the two), so
+  // one late frame is never a loss and a node leaving operational shows within a
+  // fifth of it; bring-up writes this to every node's 0x1017.
+  const double node_period_ms =
+      std::floor(std::min(c.drive_heartbeat_timeout_s, c.load_cell_heartbeat_timeout_s) * 1e3 / 5.0);
+  s.master.node_heartbeat_period_ms = static_cast<std::uint16_t>(std::clamp(node_period_ms, 1.0, 65535.0));
   s.master.spool = c.spool();
   s.master.master_node_id = c.endcap_node_id;
   s.master.producer_heartbeat_period_ns = core::seconds_to_ns(c.endcap_heartbeat_s);

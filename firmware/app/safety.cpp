@@ -59,6 +59,17 @@ FaultCause SafetyMonitor::check(const canopen::CanopenMaster& master, std::int64
   for (std::size_t i = 0; i < master.drive_count(); ++i) {
     if (!master.drive_heartbeat(i).alive) return FaultCause::drive_lost;
   }
+  // A node that left operational (its heartbeat says pre-operational or stopped)
+  // takes no RPDO and sends no TPDO: its drive holds a target the end cap can no
+  // longer move or watch. Its heartbeat carries the state, so this is seen within
+  // one of its producer periods, before any position or sample timeout.
+  for (std::size_t i = 0; i < master.drive_count(); ++i) {
+    if (master.drive_heartbeat(i).state != canopen::NmtState::operational) return FaultCause::node_not_operational;
+  }
+  if (config_.use_load_cell && master.heartbeat(canopen::NodeRole::load_cell).alive &&
+      master.heartbeat(canopen::NodeRole::load_cell).state != canopen::NmtState::operational) {
+    return FaultCause::node_not_operational;
+  }
   // Every drive is checked for the faults that quick-stop before any for a milder
   // one: a stale position latched on one drive must not hide another leaving
   // operation enabled, which would otherwise be stepped back up unseen.

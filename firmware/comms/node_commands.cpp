@@ -7,6 +7,7 @@
 // during a rejoin's overlap.
 #include <cstring>
 
+#include "firmware/comms/command_wire.hpp"
 #include "firmware/comms/endcap_node.hpp"
 #include "firmware/comms/node_dds.hpp"
 #include "firmware/comms/wire_time.hpp"
@@ -19,24 +20,13 @@ namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
 
-CommandSample to_sample(const m::Command_& cmd, const dds::SampleInfo& info, int endcap_id) {
-  CommandSample c;
+WriterId writer_of(const dds::SampleInfo& info) {
+  WriterId w;
   const auto& guid = info.sample_identity.writer_guid();
   static_assert(sizeof(guid.guidPrefix.value) + sizeof(guid.entityId.value) == sizeof(WriterId));
-  std::memcpy(c.writer.data(), guid.guidPrefix.value, sizeof(guid.guidPrefix.value));
-  std::memcpy(c.writer.data() + sizeof(guid.guidPrefix.value), guid.entityId.value, sizeof(guid.entityId.value));
-  c.format_version = cmd.format_version();
-  c.seq = cmd.seq();
-  c.kind = cmd.kind();
-  c.endcap_mask = cmd.endcap_mask();
-  c.start_host_time_ns = cmd.start_host_time_ns();
-  c.issued_host_time_ns = cmd.issued_host_time_ns();
-  if (endcap_id >= 0 && static_cast<std::size_t>(endcap_id) < cmd.estops_seen().size()) {
-    c.estops_seen.life_id = cmd.lives_seen()[static_cast<std::size_t>(endcap_id)];
-    c.estops_seen.count = cmd.estops_seen()[static_cast<std::size_t>(endcap_id)];
-  }
-  c.asked_host_time_ns = cmd.asked_host_time_ns();
-  return c;
+  std::memcpy(w.data(), guid.guidPrefix.value, sizeof(guid.guidPrefix.value));
+  std::memcpy(w.data() + sizeof(guid.guidPrefix.value), guid.entityId.value, sizeof(guid.entityId.value));
+  return w;
 }
 
 const char* kind_name(std::uint8_t kind) {
@@ -54,7 +44,7 @@ void EndcapNode::on_commands(Dds& d) {
   dds::SampleInfo info;
   while (d.command->take_next_sample(&cmd, &info) == ReturnCode_t::RETCODE_OK) {
     if (!info.valid_data) continue;
-    const CommandSample c = to_sample(cmd, info, config_.endcap_id);
+    const CommandSample c = to_sample(cmd, writer_of(info), config_.endcap_id);
     HostClockView clock;
     {
       std::lock_guard lock(mutex_);

@@ -17,6 +17,7 @@ const char* describe(FaultCause cause) noexcept {
     case FaultCause::drive_disabled: return "motor drive left operation enabled";
     case FaultCause::stale_position: return "motor drive position stale";
     case FaultCause::loop_stalled: return "control loop stalled";
+    case FaultCause::node_not_operational: return "CANopen node left operational";
   }
   return "unknown fault";
 }

@@ -16,10 +16,11 @@ enum class FaultCause : std::uint8_t {
   emergency_stop,  // commanded by an operator
   bad_input,       // the caller broke the step contract (buffer sizes)
   // CANopen supervision (docs/design/canopen.md "Supervision"):
-  node_rebooted,   // a drive or the load cell sent a boot-up after bring-up
-  drive_disabled,  // a drive left operation enabled without being asked
-  stale_position,  // no drive position newer than the configured age
-  loop_stalled,    // the real-time loop missed cycles for longer than its drives wait for its heartbeat
+  node_rebooted,         // a drive or the load cell sent a boot-up after bring-up
+  drive_disabled,        // a drive left operation enabled without being asked
+  stale_position,        // no drive position newer than the configured age
+  loop_stalled,          // the real-time loop missed cycles for longer than its drives wait for its heartbeat
+  node_not_operational,  // a drive or the load cell left NMT operational after bring-up, still beating
 };
 
 const char* describe(FaultCause cause) noexcept;

@@ -40,7 +40,11 @@ void CanopenMaster::fail_bring_up(const char* what, std::int64_t now_ns, std::ui
   const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode ||
                          step == BringUpStep::set_heartbeat_consumer || step == BringUpStep::set_abort_connection ||
                          step == BringUpStep::enable;
-  if (drive_count_ > 1 && per_drive) {
+  if (step == BringUpStep::set_heartbeat_producer) {  // every node, the load cell last
+    const bool drive = bring_up_.drive_index < drive_count_;
+    std::snprintf(where, sizeof where, "%s (%s %u)", to_string(step), drive ? "drive" : "load cell",
+                  static_cast<unsigned>(drive ? config_.drive_node(bring_up_.drive_index) : config_.load_cell_node_id));
+  } else if (drive_count_ > 1 && per_drive) {
     std::snprintf(where, sizeof where, "%s (drive %u)", to_string(bring_up_.step),
                   static_cast<unsigned>(config_.drive_node(bring_up_.drive_index)));
   } else {
@@ -124,6 +128,37 @@ bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
   return true;
 }
 
+// 0x1017 of node bring_up_.drive_index (the load cell after the drives): starts the
+// write once, then waits for its outcome. True when every node is done or bring-up
+// failed. The node's heartbeat follows the new period from its next beat, so the
+// consumer's timeouts hold whatever the device's factory default was.
+bool CanopenMaster::step_producer_sdo(std::int64_t now_ns) {
+  BringUp& b = bring_up_;
+  const std::size_t nodes = drive_count_ + (config_.use_load_cell ? 1 : 0);
+  if (config_.node_heartbeat_period_ms == 0 || b.drive_index >= nodes) {
+    enter_step(BringUpStep::set_mode, now_ns);
+    return true;
+  }
+  const NodeRef node =
+      b.drive_index < drive_count_ ? NodeRef{NodeRole::drive, b.drive_index} : NodeRef{NodeRole::load_cell, 0};
+  SdoClient& sdo = sdo_client(node);
+  if (!b.request_sent) {
+    b.request_sent = sdo_start(node, false, {kOdProducerHeartbeatTime, 0}, config_.node_heartbeat_period_ms, 2, now_ns);
+    return false;
+  }
+  if (sdo.transfer().status == SdoStatus::pending) return false;
+  const SdoTransfer done = sdo.transfer();
+  sdo.acknowledge();
+  if (done.status != SdoStatus::done) {
+    fail_bring_up("writing 0x1017", now_ns, done.abort_code);
+    return true;
+  }
+  const std::size_t following = b.drive_index + 1;
+  enter_step(BringUpStep::set_heartbeat_producer, now_ns);
+  b.drive_index = following;
+  return step_producer_sdo(now_ns);
+}
+
 void CanopenMaster::step_bring_up(std::int64_t now_ns) {
   BringUp& b = bring_up_;
   if (b.step == BringUpStep::idle || b.step == BringUpStep::done || b.step == BringUpStep::failed) return;
@@ -155,9 +190,13 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
     case BringUpStep::wait_boot:
       if (all_drives([&](std::size_t i) { return heard_since_step(drives_[i].hb); }) &&
           (!config_.use_load_cell || heard_since_step(load_cell_hb_))) {
-        enter_step(BringUpStep::set_mode, now_ns);
+        enter_step(BringUpStep::set_heartbeat_producer, now_ns);
+        step_producer_sdo(now_ns);
         return;
       }
+      break;
+    case BringUpStep::set_heartbeat_producer:
+      if (step_producer_sdo(now_ns)) return;
       break;
     case BringUpStep::set_mode:
     case BringUpStep::check_mode:

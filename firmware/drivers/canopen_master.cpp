@@ -29,6 +29,7 @@ const char* to_string(BringUpStep step) {
   switch (step) {
     case BringUpStep::idle: return "idle";
     case BringUpStep::wait_boot: return "waiting for boot-up";
+    case BringUpStep::set_heartbeat_producer: return "setting heartbeat producer time";
     case BringUpStep::set_mode: return "setting mode CSP";
     case BringUpStep::check_mode: return "checking mode";
     case BringUpStep::set_heartbeat_consumer: return "configuring heartbeat consumer";

@@ -44,6 +44,9 @@ struct CanopenMasterConfig {
   // Per node: a few producer periods (nodes here beat every 20 ms or so).
   std::int64_t drive_heartbeat_timeout_ns = 100'000'000;
   std::int64_t load_cell_heartbeat_timeout_ns = 100'000'000;
+  // What bring-up writes to every node's 0x1017 (producer heartbeat time, ms), so the
+  // timeouts above do not rest on each device's factory default; 0: left as it is.
+  std::uint16_t node_heartbeat_period_ms = 20;
   std::int64_t sdo_timeout_ns = 50'000'000;
   std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
   std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
@@ -122,6 +125,7 @@ struct MasterEvent {
 enum class BringUpStep : std::uint8_t {
   idle,
   wait_boot,               // after NMT reset communication: wait for each node's boot-up/heartbeat
+  set_heartbeat_producer,  // SDO 0x1017 = node_heartbeat_period_ms on each drive, then the load cell
   set_mode,                // SDO 0x6060 = 8 (cyclic synchronous position)
   check_mode,              // SDO 0x6061 must read 8
   set_heartbeat_consumer,  // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
@@ -198,7 +202,9 @@ class CanopenMaster {
     BringUpStep step = BringUpStep::idle;
     std::int64_t step_started_ns = 0;
     bool request_sent = false;
-    std::size_t drive_index = 0;  // set_mode / check_mode go through the drives in turn
+    // The per-node steps go through the drives in turn (set_heartbeat_producer then
+    // takes the load cell as index drive_count).
+    std::size_t drive_index = 0;
     std::array<char, 128> failure{};
   };
   // Everything the master keeps per drive node.
@@ -245,6 +251,7 @@ class CanopenMaster {
   bool step_enable(std::int64_t now_ns);
   void fail_step_after_timeout(std::int64_t now_ns);
   bool step_drive_sdo(std::int64_t now_ns, BringUpStep& next);
+  bool step_producer_sdo(std::int64_t now_ns);
   void enter_step(BringUpStep step, std::int64_t now_ns);
   void fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t detail = 0);
 

@@ -14,8 +14,10 @@ void SimNode::boot(std::int64_t now_ns, FrameOut& out) {
   consumer_node_ = 0;
   consumer_time_ms_ = 0;
   consumer_armed_ = false;
+  // 0x1017 too is a communication object: a reset brings back the factory default.
+  heartbeat_period_ns_ = script.heartbeat_period_ns;
   if (!script.silent) out.push_back(encode_heartbeat(node_id_, NmtState::boot_up));
-  next_heartbeat_ns_ = now_ns + script.heartbeat_period_ns;
+  next_heartbeat_ns_ = now_ns + heartbeat_period_ns_;
 }
 
 void SimNode::reboot(std::int64_t now_ns, FrameOut& out) {
@@ -35,9 +37,13 @@ void SimNode::tick(std::int64_t now_ns, FrameOut& out) {
     ++heartbeat_losses_;
     on_heartbeat_lost(now_ns, out);
   }
-  if (!answering() || !script.heartbeat || now_ns < next_heartbeat_ns_) return;
+  if (!answering() || !script.heartbeat || heartbeat_period_ns_ <= 0 || now_ns < next_heartbeat_ns_) return;
   out.push_back(encode_heartbeat(node_id_, nmt_));
-  next_heartbeat_ns_ = now_ns + script.heartbeat_period_ns;
+  next_heartbeat_ns_ = now_ns + heartbeat_period_ns_;
+}
+
+void SimNode::leave_operational(NmtState state) {
+  if (powered_ && nmt_ == NmtState::operational) nmt_ = state;
 }
 
 bool SimNode::consume_heartbeat(const CanFrame& frame, std::int64_t now_ns) {
@@ -129,7 +135,7 @@ bool SimNode::comm_od_read(SdoAddress a, std::uint32_t& value, std::uint8_t& siz
   }
   if (a.index == kOdProducerHeartbeatTime) {
     abort = a.subindex != 0 ? sdo_abort::kNoSubindex : 0;
-    value = static_cast<std::uint32_t>(script.heartbeat_period_ns / 1'000'000);
+    value = static_cast<std::uint32_t>(heartbeat_period_ns_ / 1'000'000);
     size = 2;
     return true;
   }
@@ -161,8 +167,8 @@ bool SimNode::comm_od_write(SdoAddress a, std::uint32_t value, std::uint8_t size
       abort = sdo_abort::kLengthMismatch;
     } else {
       abort = 0;
-      script.heartbeat_period_ns = std::int64_t{value & 0xFFFFU} * 1'000'000;
-      script.heartbeat = (value & 0xFFFFU) != 0;
+      heartbeat_period_ns_ = std::int64_t{value & 0xFFFFU} * 1'000'000;
+      next_heartbeat_ns_ = 0;  // the new period runs from the next tick, not the old schedule
     }
     return true;
   }

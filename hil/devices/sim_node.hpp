@@ -25,6 +25,8 @@ class SimNode {
  public:
   struct Script {
     bool heartbeat = true;
+    // The factory default of 0x1017: the period the device beats at after power-on
+    // or a reset, until the master writes its own (0 ms: no heartbeat).
     std::int64_t heartbeat_period_ns = 20'000'000;
     bool sdo_silent = false;            // never answer SDO requests
     std::uint32_t sdo_abort_all = 0;    // answer every SDO request with this abort
@@ -38,13 +40,17 @@ class SimNode {
   virtual ~SimNode() = default;
 
   // Power on: send boot-up, enter pre-operational. The communication objects
-  // (0x1016) are back at their power-on values: not configured.
+  // (0x1016, 0x1017) are back at their power-on values: not configured.
   void boot(std::int64_t now_ns, FrameOut& out);
   // A power cycle (brown-out, watchdog reset): application state reset, then boot.
   void reboot(std::int64_t now_ns, FrameOut& out);
   void on_frame(const CanFrame& frame, std::int64_t now_ns, FrameOut& out);
   // Time-driven output (heartbeat); call at least once per heartbeat period.
   virtual void tick(std::int64_t now_ns, FrameOut& out);
+  // Fault injection: the device leaves NMT operational by itself (its own
+  // firmware's error reaction, a local operator) and goes on beating in `state`
+  // (pre-operational or stopped): no PDOs in or out, unlike a reboot no boot-up.
+  void leave_operational(fw::canopen::NmtState state);
 
   std::uint8_t node_id() const { return node_id_; }
   fw::canopen::NmtState nmt_state() const { return nmt_; }
@@ -63,6 +69,8 @@ class SimNode {
   std::int64_t heartbeat_lost_ns() const { return heartbeat_lost_ns_; }  // last timeout (device time)
   std::uint32_t heartbeat_losses() const { return heartbeat_losses_; }
   std::uint32_t reboots() const { return reboots_; }
+  // 0x1017 as it stands (the factory default until written): the producer period.
+  std::int64_t heartbeat_period_ns() const { return heartbeat_period_ns_; }
 
  protected:
   // Object dictionary access for SDO; return 0 or an abort code.
@@ -87,6 +95,7 @@ class SimNode {
   bool powered_ = false;
   fw::canopen::NmtState nmt_ = fw::canopen::NmtState::unknown;
   std::int64_t next_heartbeat_ns_ = 0;
+  std::int64_t heartbeat_period_ns_ = 0;
   std::uint8_t consumer_node_ = 0;
   std::uint16_t consumer_time_ms_ = 0;
   bool consumer_armed_ = false;

@@ -4,6 +4,7 @@
 // in the step it is due, and timed frame faults end on time.
 #include <gtest/gtest.h>
 
+#include "firmware/drivers/nmt.hpp"
 #include "hil/fault_injector.hpp"
 #include "hil/hil_error.hpp"
 
@@ -155,6 +156,40 @@ TEST(HilFaultInjector, DeviceFaultsReachTheChosenMotors) {
   target.devices(2).preferred(rest, preferred);
   EXPECT_DOUBLE_EQ(preferred[4], 1.1) << "released: pays out to the longest rest length";
   EXPECT_DOUBLE_EQ(preferred[5], 0.9) << "seized: keeps its length";
+}
+
+// Each device booted and started by NMT, as the end cap's bring-up leaves it.
+void start_nodes(EndcapDevices& d) {
+  FrameOut out;
+  const auto start = [&](SimNode& n) {
+    n.boot(0, out);
+    n.on_frame(fw::canopen::encode_nmt(fw::canopen::NmtCommand::start, n.node_id()), 0, out);
+  };
+  for (std::size_t m = 0; m < d.motor_count(); ++m) start(d.drive(m));
+  start(d.load_cell());
+}
+
+TEST(HilFaultInjector, NodesLeaveOperationalAndGoOnBeating) {
+  Scenario s;
+  FaultParams m1;
+  m1.motor = 1;
+  s.events = {event(0.001, 0, FaultKind::drive_preoperational, m1), event(0.001, 1, FaultKind::load_cell_stopped)};
+  FaultInjector injector(s, kDtS);
+  RecordingTarget target;
+  for (int e = 0; e < 2; ++e) start_nodes(target.devices(e));
+  std::vector<std::string> log;
+  (void)run(injector, target, 2, log);
+  using fw::canopen::NmtState;
+  EXPECT_EQ(target.devices(0).drive(1).nmt_state(), NmtState::pre_operational);
+  EXPECT_EQ(target.devices(0).drive(0).nmt_state(), NmtState::operational) << "motor 1 only";
+  EXPECT_EQ(target.devices(1).load_cell().nmt_state(), NmtState::stopped);
+  EXPECT_TRUE(target.devices(1).load_cell().answering()) << "powered and beating, unlike a reboot or silence";
+  FrameOut beats;
+  target.devices(0).drive(1).tick(1'000'000'000, beats);
+  ASSERT_EQ(beats.size(), 1U);
+  EXPECT_EQ(beats[0].data[0], static_cast<std::uint8_t>(NmtState::pre_operational)) << "its heartbeat says so";
+  ASSERT_EQ(log.size(), 2U);
+  EXPECT_NE(log[0].find("drive_preoperational (motor 1)"), std::string::npos) << log[0];
 }
 
 TEST(HilFaultInjector, AMotorTheEndCapDoesNotHaveIsAnError) {

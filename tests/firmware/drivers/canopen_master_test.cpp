@@ -329,9 +329,11 @@ TEST(CanopenMaster, BringUpFailsClearlyWhenTheDriveIsSilent) {
 
 TEST(CanopenMaster, BringUpFailsWithTheAbortTextWhenCspIsRefused) {
   Bench b;
-  b.drive.script.sdo_abort_all = sdo_abort::kValueRange;
   b.power_on();
   b.master.start_bring_up(b.clock.now_ns());
+  // Its heartbeat time (0x1017) is taken; the mode is what it refuses.
+  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::set_mode; }, 100));
+  b.drive.script.sdo_abort_all = sdo_abort::kValueRange;
   ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::failed; }, 100));
   EXPECT_THAT(b.master.bring_up_failure(), HasSubstr("0x6060"));
   EXPECT_THAT(b.master.bring_up_failure(), HasSubstr("invalid value for parameter"));

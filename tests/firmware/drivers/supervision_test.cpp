@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "bench.hpp"
@@ -67,8 +68,10 @@ TEST(CanopenSupervision, EndCapHeartbeatEveryProducerPeriodFromBringUp) {
 TEST(CanopenSupervision, BringUpWritesConsumerHeartbeatAndAbortOptionBeforeStart) {
   Bench b;
   bring_up(b);
-  const std::vector<SdoMessage> d = downloads(b, 3);
-  ASSERT_EQ(d.size(), 3U);
+  std::vector<SdoMessage> d = downloads(b, 3);
+  ASSERT_EQ(d.size(), 4U);
+  EXPECT_EQ(d[0].address.index, kOdProducerHeartbeatTime);
+  d.erase(d.begin());
   EXPECT_EQ(d[0].address.index, kOdModesOfOperation);
   EXPECT_EQ(d[1].address.index, kOdConsumerHeartbeatTime);
   EXPECT_EQ(d[1].address.subindex, 1);
@@ -104,12 +107,50 @@ TEST(CanopenSupervision, ConfiguredTimesAndOptionAreWhatIsWritten) {
   EXPECT_EQ(b.drive.abort_connection_option(), AbortConnectionOption::disable_voltage);
 }
 
+TEST(CanopenSupervision, BringUpWritesTheProducerTimeOfEveryNodeFirst) {
+  CanopenMasterConfig c = sim::bench_config();
+  c.node_heartbeat_period_ms = 15;
+  Bench b(c);
+  b.drive.script.heartbeat_period_ns = 500'000'000;  // factory defaults the end cap must not rely on
+  b.load_cell.script.heartbeat_period_ns = 0;
+  bring_up(b);
+  for (const std::uint8_t node : {c.drive_node_id, c.load_cell_node_id}) {
+    const std::vector<SdoMessage> written = downloads(b, node);
+    ASSERT_FALSE(written.empty()) << "node " << int{node};
+    EXPECT_EQ(written.front().address.index, kOdProducerHeartbeatTime) << "before anything the heartbeat times";
+    EXPECT_EQ(written.front().value, 15U);
+    EXPECT_EQ(written.front().size, 2U);
+  }
+  EXPECT_EQ(b.drive.heartbeat_period_ns(), 15'000'000);
+  EXPECT_EQ(b.load_cell.heartbeat_period_ns(), 15'000'000);
+}
+
+TEST(CanopenSupervision, NoProducerTimeWrittenWhenItIsZero) {
+  CanopenMasterConfig c = sim::bench_config();
+  c.node_heartbeat_period_ms = 0;
+  Bench b(c);
+  bring_up(b);
+  for (const SdoMessage& m : downloads(b, 3)) EXPECT_NE(m.address.index, kOdProducerHeartbeatTime);
+  EXPECT_TRUE(downloads(b, 4).empty());
+}
+
+TEST(CanopenSupervision, BringUpFailsNamingTheLoadCellWhenItRefusesTheProducerTime) {
+  Bench b;
+  b.load_cell.script.sdo_abort_all = 0x0601'0002;  // read only
+  b.power_on();
+  b.master.start_bring_up(b.clock.now_ns());
+  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::failed; }, 300));
+  const std::string failure = b.master.bring_up_failure();
+  EXPECT_NE(failure.find("load cell 4"), std::string::npos) << failure;
+  EXPECT_NE(failure.find("0x1017"), std::string::npos) << failure;
+}
+
 TEST(CanopenSupervision, NoConsumerConfiguredWhenItsTimeIsZero) {
   CanopenMasterConfig c = sim::bench_config();
   c.drive_consumer_heartbeat_ms = 0;
   Bench b(c);
   bring_up(b);
-  EXPECT_EQ(downloads(b, 3).size(), 1U) << "0x6060 only";
+  EXPECT_EQ(downloads(b, 3).size(), 2U) << "0x1017 and 0x6060 only";
   EXPECT_EQ(b.drive.consumer_time_ms(), 0);
 }
 
