@@ -22,13 +22,13 @@ Examples:
   tools/arm.py --compare out/arms/A out/arms/B --out out/arms/compare --at 1000
 
 With --compare the first arm is the control: every other arm is tested against it
-at each budget both reached (tools/arm_stats.py: Mann-Whitney on the bests, Fisher
+at each budget both reached (tools/tensegrity_tools/arm_stats.py: Mann-Whitney on the bests, Fisher
 on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m). An arm is
 its directory, or the arm.csv it wrote (as kept in docs/results/arms/), so a
 recorded arm can be the control of one run on another machine:
   tools/arm.py --compare docs/results/arms/ode-replica-5000.csv out/arms/pop40 --out C
 
-An arm too long for one sitting is kept with --pack DIR (tools/arm_keep.py) and carried
+An arm too long for one sitting is kept with --pack DIR (tools/tensegrity_tools/arm_keep.py) and carried
 on elsewhere: copy DIR to a new --out and run the same command; each seed resumes from
 its packed checkpoint, also with a larger --episodes.
 """
