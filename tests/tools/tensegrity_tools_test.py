@@ -6,6 +6,7 @@ column spellings, and every script's --help.
 
 Usage: tensegrity_tools_test.py TOOLS_DIR TENSEGRITY
 """
+import ast
 import os
 import pathlib
 import subprocess
@@ -144,6 +145,25 @@ class PlotRun(unittest.TestCase):
             done = self.plot(other, pathlib.Path(d) / "x.png")
             self.assertEqual(done.returncode, 2)
             self.assertIn("curve.csv, line 1: no column time_s", done.stderr)
+
+
+def imported_modules(path):
+    """The top-level names of the modules a Python file imports (relative ones as '.')."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            names.update(a.name.split(".")[0] for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            names.add("." if node.level else node.module.split(".")[0])
+    return names
+
+
+class Imports(unittest.TestCase):
+    def test_no_script_imports_another_script_and_the_package_imports_none(self):
+        scripts = {p.stem for p in TOOLS.glob("*.py")}
+        self.assertIn("arm", scripts)
+        for path in sorted(TOOLS.glob("*.py")) + sorted((TOOLS / "tensegrity_tools").glob("*.py")):
+            self.assertEqual(imported_modules(path) & scripts, set(), f"{path.name} imports a script of tools/")
 
 
 class Help(unittest.TestCase):
