@@ -169,8 +169,7 @@ def main():
 
 
 def policy_robot_path(policy_path, policy):
-    here = os.path.dirname(os.path.abspath(__file__))
-    return os.path.join(here, "..", "robots", policy["robot"] + ".json")
+    return os.path.join(program.ROOT, "robots", policy["robot"] + ".json")
 
 
 def rest_length_limits(robot):
