@@ -36,7 +36,6 @@ import argparse
 import concurrent.futures
 import csv
 import json
-import os
 import pathlib
 import statistics
 import sys

@@ -66,7 +66,8 @@ def figure6(done, episodes, out, plt):
         for b, mm in zip(best, mean):
             rows.append((m, b[0], int(b[1]), f"{b[2]:.4f}", f"{b[3]:.4f}", f"{mm[2]:.4f}", f"{mm[3]:.4f}", b[4]))
         f_mean, f_sd = mean_sd(finals(done, m, 4.0, 5, episodes))
-        summary[m] = {"best_m": f_mean, "best_sd_m": f_sd, "last_generation_mean_m": mean[-1][2] if mean else float("nan"),
+        summary[m] = {"best_m": f_mean, "best_sd_m": f_sd,
+                      "last_generation_mean_m": mean[-1][2] if mean else float("nan"),
                       "runs": len(finals(done, m, 4.0, 5, episodes))}
     write_csv(out / "fig6_methods.csv", ["method", "generation", "episodes", "best_so_far_m", "best_so_far_sd_m",
                                          "mean_score_m", "mean_score_sd_m", "seeds"], rows)

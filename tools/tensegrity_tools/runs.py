@@ -120,7 +120,7 @@ def read_record(path, every=1):
         header = next(reader, None)
         if not header or "time_s" not in header:
             raise RecordError(f"{path}, line 1: no column time_s: not a run record")
-        rows, cut = [], None
+        rows, cut, cut_cells = [], None, 0
         for n, row in enumerate(reader):
             line = n + 2
             if cut is not None:
