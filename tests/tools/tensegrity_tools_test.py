@@ -2,13 +2,15 @@
 # SPDX-License-Identifier: Apache-2.0
 """tools/tensegrity_tools (finding and running the program, reading run records),
 tools/plot_run.py on a real `sim --telemetry` record and on HIL records of both
-column spellings, and every script's --help.
+column spellings, every script's --help and its usage in docs/reference/tools.md, and
+that no script imports another.
 
 Usage: tensegrity_tools_test.py TOOLS_DIR TENSEGRITY
 """
 import ast
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -175,6 +177,20 @@ class Help(unittest.TestCase):
                                   env=dict(os.environ, TENSEGRITY_BIN="/nowhere"))
             self.assertEqual(done.returncode, 0, f"{path.name}: {done.stderr}")
             self.assertIn("usage", done.stdout.lower(), path.name)
+
+    def test_the_reference_shows_each_scripts_usage_as_it_prints_it(self):
+        reference = (TOOLS.parent / "docs" / "reference" / "tools.md").read_text()
+        blocks = re.findall(r"```text\n(tools/(\w+)\.py .*?)\n```", reference, flags=re.S)
+        self.assertGreater(len(blocks), 5)
+        for block, name in blocks:
+            done = subprocess.run(["/usr/bin/python3", str(TOOLS / f"{name}.py"), "--help"], capture_output=True,
+                                  text=True, env=dict(os.environ, COLUMNS="80"))
+            usage = done.stdout.split("\n\n")[0]
+            # argparse indents its continuation lines under "usage: NAME.py"; the page
+            # under "tools/NAME.py", one column less.
+            expected = "\n".join(line[1:] if line.startswith(" ") else "tools/" + line[len("usage: "):]
+                                  for line in usage.split("\n"))
+            self.assertEqual(block, expected, f"docs/reference/tools.md, {name}.py: not its --help's usage")
 
 
 if __name__ == "__main__":
