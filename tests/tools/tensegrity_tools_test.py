@@ -122,6 +122,13 @@ class Records(unittest.TestCase):
             path.write_text("generation,episodes\n1,50\n")
             with self.assertRaisesRegex(runs.RecordError, "no column best_so_far_m, mean_score_m"):
                 runs.read_curve(path)
+            path.write_text("evaluations,best_m\n18,4.5\n36\n")
+            self.assertRaisesRegex(runs.RecordError, "line 3: fewer cells than the header's 2", runs.read_table, path)
+            path.write_text("evaluations,best_m\n18,4.5\n36,5,7\n")
+            self.assertRaisesRegex(runs.RecordError, "line 3: more cells", runs.read_table, path)
+            path.write_text("evaluations,best_m\n18,4.5\n36,5\n")
+            self.assertEqual(runs.read_table(path, ("best_m",)), [{"evaluations": 18.0, "best_m": 4.5},
+                                                                {"evaluations": 36.0, "best_m": 5.0}])
 
 
 class PlotRun(unittest.TestCase):

@@ -8,7 +8,8 @@
   read as well. The robot's centre is the record's centre_x_m/centre_y_m/centre_z_m
   when it has them (the HIL's), else the mean of its end caps' nodeI_x_m... (the
   simulator's), which is how the program computes it.
-- Learning curves: `tensegrity evolve --log curve.csv`, one row per generation.
+- Learning curves: `tensegrity evolve --log curve.csv`, one row per generation, and
+  other tables of numbers (tools/ceiling.py's curve.csv).
 
 A record that lacks a column or holds a cell that is not a number raises
 RecordError naming the file, the line and the column; like program.RunError it is a
@@ -135,12 +136,25 @@ def read_record(path, every=1):
     return Record(path, header, rows)
 
 
-def read_curve(path):
-    """A learning curve (`evolve --log`): one dict per generation, every column a float."""
+def read_table(path, needed=(), what="a table of numbers"):
+    """A CSV of numbers with a header (a learning curve of `evolve --log` or of
+    tools/ceiling.py): one dict per row, every column a float. `needed`: columns it
+    must have, else RecordError saying it is not `what`."""
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
-        missing = [c for c in ("episodes", "best_so_far_m", "mean_score_m") if c not in (reader.fieldnames or [])]
+        missing = [c for c in needed if c not in (reader.fieldnames or [])]
         if missing:
-            raise RecordError(f"{path}, line 1: no column {', '.join(missing)}: not a learning curve "
-                              f"(`tensegrity evolve --log`)")
-        return [{k: number(v, path, line, k) for k, v in row.items()} for line, row in enumerate(reader, start=2)]
+            raise RecordError(f"{path}, line 1: no column {', '.join(missing)}: not {what}")
+        rows = []
+        for line, row in enumerate(reader, start=2):
+            if None in row or None in row.values():
+                raise RecordError(f"{path}, line {line}: {'more' if None in row else 'fewer'} cells than the "
+                                  f"header's {len(reader.fieldnames)}")
+            rows.append({k: number(v, path, line, k) for k, v in row.items()})
+        return rows
+
+
+def read_curve(path):
+    """A learning curve (`evolve --log`): one dict per generation, every column a float."""
+    return read_table(path, ("episodes", "best_so_far_m", "mean_score_m"),
+                      "a learning curve (`tensegrity evolve --log`)")
