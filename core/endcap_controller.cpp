@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/core/endcap_controller.hpp"
+#include "core/endcap_controller.hpp"
 
 namespace tensegrity::core {
 

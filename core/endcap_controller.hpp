@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <span>
 
-#include "firmware/core/fault.hpp"
-#include "firmware/core/limits.hpp"
-#include "firmware/core/motor_loop.hpp"
-#include "firmware/core/table.hpp"
+#include "core/fault.hpp"
+#include "core/limits.hpp"
+#include "core/motor_loop.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::core {
 

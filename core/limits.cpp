@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 #include <cmath>
 #include <initializer_list>

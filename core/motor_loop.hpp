@@ -6,7 +6,7 @@
 // it then holds or pays out).
 #include <cstdint>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 namespace tensegrity::core {
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <cstdint>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 namespace tensegrity::core {
 

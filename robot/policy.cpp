@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/policy.hpp"
+#include "robot/policy.hpp"
 
 #include <cmath>
 #include <fstream>

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "firmware/core/table.hpp"
-#include "sim/robot.hpp"
+#include "core/table.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 namespace tensegrity::sim {
 
@@ -62,7 +62,7 @@ struct Robot {
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;
   double time_step_s = 0.001;
-  // engine: the rigid-body engine under the model (sim/engine.hpp), "ode" (default)
+  // engine: the rigid-body engine under the model (sim/model/engine.hpp), "ode" (default)
   // or "bullet", to tell the model's physics from its engine's.
   enum class PhysicsEngine { ode, bullet };
   PhysicsEngine engine = PhysicsEngine::ode;

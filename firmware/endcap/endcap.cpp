@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/app/endcap.hpp"
+#include "firmware/endcap/endcap.hpp"
 
 #include <pthread.h>
 #include <sched.h>
@@ -9,12 +9,12 @@
 #include <fstream>
 #include <string>
 
-#include "firmware/app/endcap_log.hpp"
+#include "firmware/endcap/endcap_log.hpp"
 #include "firmware/app/policy_file.hpp"
 #include "firmware/hal/crc32.hpp"
 #include "firmware/hal/make_can_bus.hpp"
 #ifdef TENSEGRITY_ENDCAP_DDS
-#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
 #include "msgs/dds.hpp"
 #include "msgs/security.hpp"
 #endif

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/app/endcap_log.hpp"
+#include "firmware/endcap/endcap_log.hpp"
 
 #include <cstdarg>
 #include <cstdio>

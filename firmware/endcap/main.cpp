@@ -13,8 +13,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "firmware/app/endcap.hpp"
-#include "firmware/app/endcap_log.hpp"
+#include "firmware/endcap/endcap.hpp"
+#include "firmware/endcap/endcap_log.hpp"
 
 namespace app = tensegrity::fw::app;
 

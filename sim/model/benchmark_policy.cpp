@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/benchmark_policy.hpp"
+#include "sim/model/benchmark_policy.hpp"
 
 #include <cmath>
 #include <numbers>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 

@@ -4,7 +4,7 @@
 // cable m prefers 0.85 + 0.15 sin(2 pi t / 4 + 2 pi m / 24) metres.
 #include <vector>
 
-#include "sim/controller.hpp"
+#include "sim/model/controller.hpp"
 
 namespace tensegrity::sim {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/core_controller.hpp"
+#include "sim/model/core_controller.hpp"
 
 #include <array>
 

@@ -6,9 +6,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "firmware/core/endcap_controller.hpp"
-#include "sim/controller.hpp"
-#include "sim/policy.hpp"
+#include "core/endcap_controller.hpp"
+#include "sim/model/controller.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::sim {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// The rigid-body engine under a Model (sim/model.hpp holds one; nothing else uses
+// The rigid-body engine under a Model (sim/model/model.hpp holds one; nothing else uses
 // it). The Model computes cable forces, spin damping and every measure itself;
 // the engine owns the six strut bodies, integrates them and makes their contacts.
 // Two engines, so that a result can be checked against the other contact model:
@@ -11,7 +11,7 @@
 #include <memory>
 #include <span>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 

@@ -11,7 +11,7 @@
 #include <memory>
 #include <vector>
 
-#include "sim/engine.hpp"
+#include "sim/model/engine.hpp"
 
 namespace tensegrity::sim {
 namespace {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/engine.hpp"
-#include "sim/model.hpp"
+#include "sim/model/engine.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <string>
 
-#include "sim/controller.hpp"
-#include "sim/model.hpp"
-#include "sim/robot.hpp"
-#include "sim/telemetry.hpp"
+#include "sim/model/controller.hpp"
+#include "sim/model/model.hpp"
+#include "robot/robot.hpp"
+#include "sim/model/telemetry.hpp"
 
 namespace tensegrity::sim {
 

@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "firmware/core/rate_limit.hpp"
-#include "sim/strut_frame.hpp"
+#include "core/rate_limit.hpp"
+#include "sim/model/strut_frame.hpp"
 
 namespace tensegrity::sim {
 

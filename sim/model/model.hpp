@@ -3,7 +3,7 @@
 // The robot: struts as capsule bodies, cables as one-sided spring-dampers between
 // strut end points whose rest lengths motors drive, a ground plane, and
 // (robot.rod_contact) capsules that collide with each other. The bodies live in the
-// robot's rigid-body engine (sim/engine.hpp: ODE by default, or Bullet); cable
+// robot's rigid-body engine (sim/model/engine.hpp: ODE by default, or Bullet); cable
 // forces, spin damping and every measure are computed here, the same for both.
 #include <Eigen/Core>
 #include <cstdint>
@@ -14,8 +14,8 @@
 #include <utility>
 #include <vector>
 
-#include "sim/engine.hpp"
-#include "sim/robot.hpp"
+#include "sim/model/engine.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 

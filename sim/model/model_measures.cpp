@@ -2,7 +2,7 @@
 // Reading a Model's state: end-cap positions, energies, spin (stepping is model.cpp).
 #include <cmath>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim {
 

@@ -10,7 +10,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/strut_frame.hpp"
+#include "sim/model/strut_frame.hpp"
 
 #include <Eigen/Geometry>
 

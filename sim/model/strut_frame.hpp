@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <span>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 

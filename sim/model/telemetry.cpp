@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/telemetry.hpp"
+#include "sim/model/telemetry.hpp"
 
 #include <stdexcept>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim {
 

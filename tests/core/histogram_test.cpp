@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/core/histogram.hpp"
+#include "core/histogram.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 namespace tensegrity::core {
 namespace {

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/core/motor_loop.hpp"
+#include "core/motor_loop.hpp"
 
 #include <gtest/gtest.h>
 
-#include "firmware/core/rate_limit.hpp"
+#include "core/rate_limit.hpp"
 
 namespace tensegrity::core {
 namespace {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/core/table.hpp"
+#include "core/table.hpp"
 
 #include <gtest/gtest.h>
 

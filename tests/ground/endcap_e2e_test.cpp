@@ -20,8 +20,8 @@
 
 #include "ground/upload.hpp"
 #include "hil/process_launcher.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 #include "tests/ground/subprocess.hpp"
 
 namespace tensegrity::ground {

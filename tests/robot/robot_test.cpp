@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

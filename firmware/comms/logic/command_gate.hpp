@@ -37,8 +37,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "firmware/comms/estop_count.hpp"
-#include "firmware/comms/reasons.hpp"
+#include "firmware/comms/wire/estop_count.hpp"
+#include "firmware/comms/wire/reasons.hpp"
 
 namespace tensegrity::fw::comms {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/command_wire.hpp"
+#include "firmware/comms/logic/command_wire.hpp"
 
 namespace tensegrity::fw::comms {
 

@@ -5,7 +5,7 @@
 // is what the node feeds it.
 #pragma once
 
-#include "firmware/comms/command_gate.hpp"
+#include "firmware/comms/logic/command_gate.hpp"
 #include "tensegrity_msgs/msg/Command.h"
 
 namespace tensegrity::fw::comms {

@@ -8,8 +8,8 @@
 // telemetry after the start time catches that.
 #pragma once
 
-#include "firmware/comms/reasons.hpp"
-#include "firmware/core/fault.hpp"
+#include "firmware/comms/wire/reasons.hpp"
+#include "core/fault.hpp"
 
 namespace tensegrity::fw::comms {
 

@@ -23,7 +23,7 @@
 #include <array>
 #include <cstdint>
 
-#include "firmware/comms/clock_sync.hpp"
+#include "firmware/comms/wire/clock_sync.hpp"
 
 namespace tensegrity::fw::comms {
 

@@ -2,15 +2,15 @@
 // EndcapNode: construction, the DDS entities, the node thread and the loop's side
 // of the hand-over. The work itself is in node_tables.cpp, node_commands.cpp,
 // node_status.cpp, node_time_sync.cpp and node_rejoin.cpp.
-#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdarg>
 #include <random>
 
-#include "firmware/comms/node_dds.hpp"
-#include "firmware/core/table.hpp"
+#include "firmware/comms/node/node_dds.hpp"
+#include "core/table.hpp"
 #include "msgs/endcap_writers.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"

@@ -7,10 +7,10 @@
 // during a rejoin's overlap.
 #include <cstring>
 
-#include "firmware/comms/command_wire.hpp"
-#include "firmware/comms/endcap_node.hpp"
-#include "firmware/comms/node_dds.hpp"
-#include "firmware/comms/wire_time.hpp"
+#include "firmware/comms/logic/command_wire.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
+#include "firmware/comms/node/node_dds.hpp"
+#include "firmware/comms/wire/wire_time.hpp"
 #include "tensegrity_msgs/msg/Command.h"
 #include "tensegrity_msgs/msg/CommandAck.h"
 

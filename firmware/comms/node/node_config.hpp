@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The end cap DDS node's settings (firmware/comms/endcap_node.hpp).
+// The end cap DDS node's settings (firmware/comms/node/endcap_node.hpp).
 #pragma once
 
 #include <atomic>
@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <string>
 
-#include "firmware/comms/policy_wire.hpp"
-#include "firmware/comms/start_grid.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
+#include "firmware/comms/wire/start_grid.hpp"
 
 namespace tensegrity::fw::comms {
 

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
 #include "msgs/dds.hpp"
 
 namespace tensegrity::fw::comms {

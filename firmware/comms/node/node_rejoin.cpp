@@ -12,8 +12,8 @@
 #include <cmath>
 #include <exception>
 
-#include "firmware/comms/endcap_node.hpp"
-#include "firmware/comms/node_dds.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
+#include "firmware/comms/node/node_dds.hpp"
 #include "msgs/security.hpp"
 
 namespace tensegrity::fw::comms {

@@ -4,8 +4,8 @@
 #include <array>
 #include <cmath>
 
-#include "firmware/comms/endcap_node.hpp"
-#include "firmware/comms/node_dds.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
+#include "firmware/comms/node/node_dds.hpp"
 #include "tensegrity_msgs/msg/Heartbeat.h"
 #include "tensegrity_msgs/msg/Telemetry.h"
 

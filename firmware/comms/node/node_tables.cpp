@@ -5,9 +5,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "firmware/comms/endcap_node.hpp"
-#include "firmware/comms/node_dds.hpp"
-#include "firmware/core/table.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
+#include "firmware/comms/node/node_dds.hpp"
+#include "core/table.hpp"
 #include "tensegrity_msgs/msg/PolicyAck.h"
 
 namespace tensegrity::fw::comms {

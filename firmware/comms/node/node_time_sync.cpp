@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Time-sync requests (node thread) and replies (Fast DDS's receive thread); the
 // judging is TimeSyncClient's (time_sync_client.hpp).
-#include "firmware/comms/endcap_node.hpp"
-#include "firmware/comms/node_dds.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
+#include "firmware/comms/node/node_dds.hpp"
 #include "tensegrity_msgs/msg/TimeSync.h"
 
 namespace tensegrity::fw::comms {

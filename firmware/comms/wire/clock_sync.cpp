@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/clock_sync.hpp"
+#include "firmware/comms/wire/clock_sync.hpp"
 
-#include "firmware/comms/wire_time.hpp"
+#include "firmware/comms/wire/wire_time.hpp"
 
 namespace tensegrity::fw::comms {
 

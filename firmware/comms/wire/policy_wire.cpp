@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/policy_wire.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
 
 #include <bit>
 #include <cstdio>

@@ -14,9 +14,9 @@
 #include <cstdint>
 #include <string>
 
-#include "firmware/comms/reasons.hpp"
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "firmware/comms/wire/reasons.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 #include "tensegrity_msgs/msg/PolicyTable.h"
 
 namespace tensegrity::fw::comms {

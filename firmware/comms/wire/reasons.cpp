@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/reasons.hpp"
+#include "firmware/comms/wire/reasons.hpp"
 
 namespace tensegrity::fw::comms {
 

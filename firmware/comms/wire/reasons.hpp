@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "firmware/core/table.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::fw::comms {
 
