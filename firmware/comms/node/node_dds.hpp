@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The DDS entities of one EndcapNode (internal to firmware/comms).
+// The DDS entities of one EndcapNode (internal to firmware/comms/node).
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
