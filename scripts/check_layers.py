@@ -4,14 +4,14 @@
 declarative table scripts/layers.json (README "What is here", docs/design/architecture.md).
 
 A room is one folder of the tree, and every tracked C++ file belongs to the room
-whose folder is the longest prefix of its path. Each #include "..." of another
-room's file must name a room in its own room's may_include (the rooms its CMake
-target links), and must not reach a room whose folder holds the includer's own
-(an include that runs back up a floor: the rooms a room stands on sit beside it,
-never above it). Each #include <...> must obey the room's system rule ("std": the
-C++ standard library only, as core/ must; "forbid": prefixes such as fastdds/ that
-the room must not touch). A violation names the file, the line, the include and
-the rule.
+whose folder is the longest prefix of its path (a file in no room's folder is a
+violation too). Each #include "..." of another room's file must name a room in its
+own room's may_include (the rooms its CMake target links), and must not reach a
+room whose folder holds the includer's own (an include that runs back up a floor:
+the rooms a room stands on sit beside it, never above it). Each #include <...> must
+obey the room's system rule ("std": the C++ standard library only, as core/ must;
+"forbid": prefixes such as fastdds/ that the room must not touch). A violation
+names the file, the line, the include and the rule.
 
 Every target has the source root as its include directory (cmake/Rooms.cmake), so
 the compiler would find any header: this check is what keeps the rooms apart.
@@ -79,7 +79,8 @@ def room_of(path, rooms):
 def check_file(root, rel, rooms, tracked):
     own = room_of(rel, rooms)
     if own is None:
-        return []
+        # Every C++ file sits in a room's folder: a file outside them is unchecked.
+        return [f"{rel}: in no room's folder (scripts/layers.json)"]
     problems = []
     with open(os.path.join(root, rel), encoding="utf-8", errors="replace") as f:
         for n, line in enumerate(f, 1):
@@ -137,6 +138,7 @@ def self_test():
         "app/y.cpp": "#include \"net/n.hpp\"\n#include \"app/x.hpp\"\n",
         "app/prog/main.cpp": "#include \"net/n.hpp\"\n#include \"core/a.hpp\"\n#include \"app/x.hpp\"\n",
         "net/n.hpp": "#include \"core/a.hpp\"\n#include \"unknown/not_tracked.hpp\"\n",
+        "stray/s.cpp": "#include \"core/a.hpp\"\n",
     }
     with tempfile.TemporaryDirectory() as d:
         for rel, text in files.items():
@@ -149,7 +151,7 @@ def self_test():
         got = check_tree(d, rules_path, list(files))
     expect = ["core/bad.hpp:1: #include <unistd.h>", "core/bad.hpp:2: #include \"app/x.hpp\"",
               "app/x.hpp:2: #include <fastdds/dds/x.hpp>", "app/y.cpp:1: #include \"net/n.hpp\"",
-              "app/prog/main.cpp:3: #include \"app/x.hpp\""]
+              "app/prog/main.cpp:3: #include \"app/x.hpp\"", "stray/s.cpp: in no room's folder"]
     ok = len(got) == len(expect) and all(any(p.startswith(e) for p in got) for e in expect)
     if not ok:
         print("check_layers self-test FAILED; expected violations:\n  " + "\n  ".join(expect) +
