@@ -2,7 +2,7 @@
 #include "hil/recorder.hpp"
 
 #include "hil/hil_error.hpp"
-#include "sim/telemetry.hpp"
+#include "sim/model/telemetry.hpp"
 
 namespace tensegrity::hil {
 

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "sim/telemetry.hpp"
+#include "sim/model/telemetry.hpp"
 #include "view/csv_table.hpp"
 #include "view/json_numbers.hpp"
 

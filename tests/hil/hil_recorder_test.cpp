@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/robot.hpp"
-#include "sim/telemetry.hpp"
+#include "robot/robot.hpp"
+#include "sim/model/telemetry.hpp"
 
 namespace tensegrity::hil {
 namespace {
