@@ -108,7 +108,8 @@ def ground_runs():
 
 def replay_csvs():
     """Telemetry CSVs for the view's replay (view/replay_data.hpp), for the shipped robot:
-    `tensegrity sim --telemetry`'s spelling with energies, and the HIL record's without."""
+    `tensegrity sim --telemetry`'s spelling with energies, and the older HIL records' spelling
+    (tension_n_3 for cable3_tension_n, still read) without."""
     import json
     robot = json.loads((M.ROOT / "robots" / "superball.json").read_text())
     nodes, cables = len(robot["nodes_m"]), len(robot["cables"])

@@ -2,6 +2,7 @@
 #include "hil/recorder.hpp"
 
 #include "hil/hil_error.hpp"
+#include "sim/model/telemetry.hpp"
 
 namespace tensegrity::hil {
 
@@ -9,10 +10,11 @@ Recorder::Recorder(const std::filesystem::path& path, const sim::Model& model) :
   file_ = std::fopen(path.c_str(), "w");
   if (file_ == nullptr) throw HilError(path.string() + ": cannot create the record file");
   std::fputs("time_s,centre_x_m,centre_y_m,centre_z_m", file_);
-  for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",rest_length_m_%d", c);
-  for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",tension_n_%d", c);
-  // Every end cap's position and the energies, named as in `tensegrity sim
-  // --telemetry`: what `tensegrity view` needs to draw the robot.
+  // Every column named as in `tensegrity sim --telemetry` (cableM_tension_n, nodeI_x_m,
+  // the energies): the view and tools/ read both records alike.
+  for (const char* what : {"rest_length_m", "tension_n"}) {
+    for (int c = 0; c < model.cable_count(); ++c) std::fprintf(file_, ",%s", sim::cable_column(c, what).c_str());
+  }
   for (int i = 0; i < model.robot().node_count(); ++i)
     std::fprintf(file_, ",node%d_x_m,node%d_y_m,node%d_z_m", i, i, i);
   std::fputs(",kinetic_energy_j,gravity_energy_j,elastic_energy_j", file_);

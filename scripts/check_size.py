@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""The size rule of the project's guide, enforced: outside tests/, no source file
-over 400 lines and no function over 80 lines, except those listed with a reason in
-scripts/size-exceptions.txt (and docs/design/architecture.md, "Size exceptions").
+"""The size rule of the project's guide, enforced: outside tests/, no source file (C++
+or Python) over 400 lines and no function over 80 lines, except those listed with a
+reason in scripts/size-exceptions.txt (and docs/design/architecture.md, "Size exceptions").
 
-Files: a plain line count. Functions: clang-tidy's readability-function-size with
+Files: a plain line count. Python functions (and methods, nested ones each on their
+own): Python's own parser (`ast`), from the `def` line to the function's last line.
+C++ functions: clang-tidy's readability-function-size with
 LineThreshold 80, over the build's compile_commands.json. clang-tidy parses every
 header a file includes (Eigen, Fast DDS: 5-10 s of CPU per file), so it runs only on
 the files that can hold a function over 80 lines: those with a brace block longer
@@ -16,6 +18,7 @@ clang-tidy on every file to show it.
   scripts/check_size.py [-p build/default] [--all] [--self-test] [-j N]
 """
 import argparse
+import ast
 import concurrent.futures
 import os
 import re
@@ -29,6 +32,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MAX_FILE_LINES = 400
 MAX_FUNCTION_LINES = 80
 SOURCE = re.compile(r"\.(cpp|cc|c|hpp|h)$")
+PYTHON = re.compile(r"\.py$")
 TYPE_BLOCK = re.compile(r"^\s*(template\s*<.*>\s*)?(namespace|class|struct|union|enum|extern)\b")
 TIDY_CONFIG = "{CheckOptions: [{key: readability-function-size.LineThreshold, value: %d}]}" % MAX_FUNCTION_LINES
 WARNING = re.compile(r"^(.*?):(\d+):\d+: warning: function '([^']*)' exceeds recommended size")
@@ -36,6 +40,51 @@ WARNING = re.compile(r"^(.*?):(\d+):\d+: warning: function '([^']*)' exceeds rec
 
 def sources():
     return [f for f in source_files.files(ROOT) if SOURCE.search(f) and not f.startswith("tests/")]
+
+
+def python_sources():
+    return [f for f in source_files.files(ROOT) if PYTHON.search(f) and not f.startswith("tests/")]
+
+
+def python_functions(path):
+    """(line, qualified name, lines) of every function and method in a Python file;
+    a nested function is named outer.inner and counted inside its outer one too."""
+    with open(os.path.join(ROOT, path), encoding="utf-8") as f:
+        tree = ast.parse(f.read(), filename=path)
+    found = []
+
+    def walk(node, prefix):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                name = prefix + child.name
+                if not isinstance(child, ast.ClassDef):
+                    found.append((child.lineno, name, child.end_lineno - child.lineno + 1))
+                walk(child, name + ".")
+            else:
+                walk(child, prefix)
+
+    walk(tree, "")
+    return found
+
+
+def python_problems(files, function_ok, used):
+    """The Python functions over the limit that are not listed (listed ones go to `used`)."""
+    problems = []
+    for path in files:
+        try:
+            functions = python_functions(path)
+        except SyntaxError as e:
+            problems.append(f"{path}:{e.lineno}: not Python the checker can parse ({e.msg})")
+            continue
+        for line, name, length in functions:
+            if length <= MAX_FUNCTION_LINES:
+                continue
+            key = next((k for k in ((path, name), (path, name.split(".")[-1])) if k in function_ok), None)
+            if key:
+                used.add(("function",) + key)
+            else:
+                problems.append(f"{path}:{line}: function '{name}' is {length} lines (at most {MAX_FUNCTION_LINES})")
+    return problems
 
 
 def read_exceptions(path):
@@ -124,9 +173,33 @@ def tidy(path, build_dir):
     return found
 
 
+def python_self_test():
+    """The Python count flags a planted 81-line function (a nested one and a method too)
+    and not an 80-line one."""
+    with tempfile.TemporaryDirectory() as d:
+        with open(os.path.join(d, "planted.py"), "w", encoding="utf-8") as f:
+            for name, n in (("long_one", MAX_FUNCTION_LINES + 1), ("short_one", MAX_FUNCTION_LINES)):
+                f.write("def %s(x):\n%s    return x\n\n\n" % (name, "    x += 1\n" * (n - 2)))
+            f.write("class Planted:\n    def method(self):\n        def inner():\n%s            return 1\n"
+                    "        return inner\n" % ("            pass\n" * (MAX_FUNCTION_LINES - 1)))
+        global ROOT
+        saved, ROOT = ROOT, d
+        try:
+            flagged = python_problems(["planted.py"], {}, set())
+        finally:
+            ROOT = saved
+    names = [re.search(r"function '([^']*)'", p).group(1) for p in flagged]
+    if names != ["long_one", "Planted.method", "Planted.method.inner"]:
+        sys.exit(f"size check self-test: the Python count flagged {names}, "
+                 f"expected ['long_one', 'Planted.method', 'Planted.method.inner']")
+    print("size check self-test: a Python function of 81 lines is flagged (also a method and a nested one), "
+          "one of 80 is not")
+
+
 def self_test(jobs):
     """clang-tidy and the pre-filter flag a planted 81-line function and not an 80-line one
     (clang-tidy's count: from the line of the opening brace to that of the closing one)."""
+    python_self_test()
     with tempfile.TemporaryDirectory() as d:
         path = os.path.join(d, "planted.cpp")
         with open(path, "w", encoding="utf-8") as f:
@@ -161,7 +234,8 @@ def main():
     file_ok, function_ok = read_exceptions(args.exceptions)
     problems, used = [], set()
     files = sources()
-    for path in files:
+    python = python_sources()
+    for path in files + python:
         with open(os.path.join(ROOT, path), encoding="utf-8", errors="replace") as f:
             count = sum(1 for _ in f)
         if count > MAX_FILE_LINES:
@@ -186,9 +260,10 @@ def main():
             used.add(("function",) + key)
         else:
             problems.append(f"{path}:{line}: function '{name}' over {MAX_FUNCTION_LINES} lines")
+    problems += python_problems(python, function_ok, used)
     stale = [f"file {p}" for p in file_ok if ("file", p) not in used] + \
             [f"function {p} {n}" for (p, n) in function_ok if ("function", p, n) not in used]
-    print(f"size check: {len(files)} files counted, {len(candidates)} through clang-tidy, "
+    print(f"size check: {len(files)} C++ and {len(python)} Python files counted, {len(candidates)} through clang-tidy, "
           f"{len(used)} listed exceptions in use")
     for s in stale:  # a warning: the branch that fixed it may land before the list is edited
         print(f"size check: warning: {args.exceptions}: '{s}' is within the limits now: remove it", file=sys.stderr)

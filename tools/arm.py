@@ -22,13 +22,13 @@ Examples:
   tools/arm.py --compare out/arms/A out/arms/B --out out/arms/compare --at 1000
 
 With --compare the first arm is the control: every other arm is tested against it
-at each budget both reached (tools/arm_stats.py: Mann-Whitney on the bests, Fisher
+at each budget both reached (tools/tensegrity_tools/arm_stats.py: Mann-Whitney on the bests, Fisher
 on the seeds >= 28 m, log-rank on the episode of the first team >= 32 m). An arm is
 its directory, or the arm.csv it wrote (as kept in docs/results/arms/), so a
 recorded arm can be the control of one run on another machine:
   tools/arm.py --compare docs/results/arms/ode-replica-5000.csv out/arms/pop40 --out C
 
-An arm too long for one sitting is kept with --pack DIR (tools/arm_keep.py) and carried
+An arm too long for one sitting is kept with --pack DIR (tools/tensegrity_tools/arm_keep.py) and carried
 on elsewhere: copy DIR to a new --out and run the same command; each seed resumes from
 its packed checkpoint, also with a larger --episodes.
 """
@@ -36,16 +36,13 @@ import argparse
 import concurrent.futures
 import csv
 import json
-import os
 import pathlib
 import statistics
-import subprocess
 import sys
 
-import arm_keep
-import arm_stats
+from tensegrity_tools import arm_keep, arm_stats, program, robot_file, runs
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = program.ROOT
 TARGET_M = 32.0
 NEAR_M = 28.0
 # An arm's arm.csv: one row per seed and budget.
@@ -56,11 +53,10 @@ RECORDED_COLUMNS = ["budget", "seed", "episodes", "best_m", "generation_mean_m",
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="arm directory (or the comparison's, with --compare)")
-    p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
+    program.add_option(p)
     p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
                    help="robot description (default: the default robot, the paper's simulated SUPERball)")
-    p.add_argument("--set", action="append", default=[], metavar="PATH=JSON",
-                   help="change a robot field, e.g. strut.axial_damping_n_m_s=0.05 (repeatable)")
+    robot_file.add_set_option(p)
     p.add_argument("--seeds", type=int, default=10, help="seeds per arm (default: %(default)s)")
     p.add_argument("--first-seed", type=int, default=1)
     p.add_argument("--episodes", type=int, default=1000, help="episode budget per seed (default: %(default)s)")
@@ -80,31 +76,6 @@ def parse_args():
     return p.parse_args()
 
 
-def set_field(doc, path, value_text):
-    keys = path.split(".")
-    node = doc
-    for k in keys[:-1]:
-        node = node.setdefault(k, {})
-    node[keys[-1]] = json.loads(value_text)
-
-
-def write_robot(args, out):
-    doc = json.loads(pathlib.Path(args.robot).read_text())
-    for item in args.set:
-        if "=" not in item:
-            sys.exit(f"--set {item}: expected PATH=JSON")
-        path, value = item.split("=", 1)
-        set_field(doc, path, value)
-    robot = out / "robot.json"
-    text = json.dumps(doc, indent=2) + "\n"
-    if robot.exists() and robot.read_text() != text and any(out.glob("runs/s*/ckpt")):
-        sys.exit(f"{robot}: this arm's seeds learned on another robot; give the same --robot and --set "
-                 f"to resume it, or a new --out")
-    if not robot.exists() or robot.read_text() != text:
-        robot.write_text(text)
-    return robot
-
-
 def run_seed(args, robot, seed):
     run = pathlib.Path(args.out) / "runs" / f"s{seed}"
     run.mkdir(parents=True, exist_ok=True)
@@ -115,22 +86,16 @@ def run_seed(args, robot, seed):
     summary = run / "summary.json"
     if summary.exists() and json.loads(summary.read_text()).get("episodes", 0) >= args.episodes:
         return seed, "reused"
-    cmd = ["nice", "-n", str(args.nice), args.tensegrity, "evolve", "--robot", str(robot),
-           "--episodes", str(args.episodes), "--seed", str(seed), "--threads", str(args.threads),
-           "--checkpoint", str(run / "ckpt"), "--resume", "--out", str(run / "policy.json"),
-           "--log", str(run / "curve.csv"), "--json"] + args.evolve_args
-    with open(run / "stderr.log", "w") as err:
-        result = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=err, text=True)
-    if result.returncode != 0:
-        return seed, f"FAILED ({result.returncode}), see {run / 'stderr.log'}"
-    summary.write_text(result.stdout)
-    (run / "command.txt").write_text(" ".join(cmd[3:]) + "\n")
+    evolve = ["evolve", "--robot", str(robot), "--episodes", str(args.episodes), "--seed", str(seed),
+              "--threads", str(args.threads), "--checkpoint", str(run / "ckpt"), "--resume",
+              "--out", str(run / "policy.json"), "--log", str(run / "curve.csv"), "--json"] + args.evolve_args
+    try:
+        result = program.run(args.tensegrity, evolve, nice=args.nice, stderr_path=run / "stderr.log")
+    except program.RunError as e:
+        return seed, f"FAILED: {e}"
+    summary.write_text(json.dumps(result, indent=2) + "\n")
+    (run / "command.txt").write_text(" ".join([args.tensegrity] + evolve) + "\n")
     return seed, "done"
-
-
-def read_curve(path):
-    with open(path) as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
 def seed_metrics(curve, budget):
@@ -192,8 +157,8 @@ def budgets(args, episodes):
 
 
 def summarise_arm(out, args, write=True):
-    runs = sorted((out / "runs").glob("s*/curve.csv"), key=lambda p: int(p.parent.name[1:]))
-    curves = {int(p.parent.name[1:]): read_curve(p) for p in runs}
+    curve_files = sorted((out / "runs").glob("s*/curve.csv"), key=lambda p: int(p.parent.name[1:]))
+    curves = {int(p.parent.name[1:]): runs.read_curve(p) for p in curve_files}
     curves = {s: c for s, c in curves.items() if c}
     episodes = max((int(c[-1]["episodes"]) for c in curves.values()), default=0)
     result = {"arm": out.name, "command": (out / "command.txt").read_text().strip()
@@ -377,7 +342,8 @@ def main():
     # A summary only reads: writing --robot's default into the arm would replace the
     # record of the robot its seeds learned on (it once did).
     if not args.summary_only:
-        robot = write_robot(args, out)
+        args.tensegrity = program.find(args.tensegrity)
+        robot = robot_file.write_robot(args.robot, args.set, out)
         seeds = range(args.first_seed, args.first_seed + args.seeds)
         (out / "command.txt").write_text(" ".join([sys.argv[0]] + sys.argv[1:]) + "\n")
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:

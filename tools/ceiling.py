@@ -22,12 +22,13 @@ import csv
 import json
 import math
 import os
-import subprocess
 import sys
 import tempfile
 import time
 
 import numpy as np
+
+from tensegrity_tools import program
 
 
 def play(binary, policy, values, lo, hi, tmpdir, tag):
@@ -40,15 +41,13 @@ def play(binary, policy, values, lo, hi, tmpdir, tag):
     path = os.path.join(tmpdir, f"c{tag}.json")
     with open(path, "w") as f:
         json.dump(p, f)
-    out = subprocess.run([binary, "sim", "--policy", path, "--json"],
-                         check=True, capture_output=True, text=True).stdout
-    r = json.loads(out)
+    r = program.sim(binary, path)
     return (r["distance_m"] if r["feasible"] else 0.0), r
 
 
-def main():
+def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--binary", default="build/release/cli/tensegrity")
+    program.add_option(ap)
     ap.add_argument("--start", required=True,
                     help="policy JSON: its table is the initial mean, its robot and period are kept")
     ap.add_argument("--random-start", action="store_true",
@@ -59,7 +58,90 @@ def main():
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", required=True, help="directory: curve.csv, best.json")
     a = ap.parse_args()
+    a.tensegrity = program.find(a.tensegrity)
+    return a
 
+
+class CmaEs:
+    """Hansen's (mu/mu_w, lambda)-CMA-ES with his default strategy parameters; the
+    mean is kept within [lo, hi]."""
+
+    def __init__(self, x0, sigma, lo, hi):
+        dim = x0.size
+        self.dim, self.lo, self.hi = dim, lo, hi
+        self.lam = 4 + int(3 * math.log(dim))
+        self.mu = self.lam // 2
+        w = np.log(self.mu + 0.5) - np.log(np.arange(1, self.mu + 1))
+        self.w = w / w.sum()
+        self.mueff = 1.0 / np.sum(self.w ** 2)
+        self.cc = (4 + self.mueff / dim) / (dim + 4 + 2 * self.mueff / dim)
+        self.cs = (self.mueff + 2) / (dim + self.mueff + 5)
+        self.c1 = 2 / ((dim + 1.3) ** 2 + self.mueff)
+        self.cmu = min(1 - self.c1, 2 * (self.mueff - 2 + 1 / self.mueff) / ((dim + 2) ** 2 + self.mueff))
+        self.damps = 1 + 2 * max(0, math.sqrt((self.mueff - 1) / (dim + 1)) - 1) + self.cs
+        self.chin = math.sqrt(dim) * (1 - 1 / (4 * dim) + 1 / (21 * dim * dim))
+        self.mean, self.sigma, self.gen = x0.copy(), sigma, 0
+        self.C = np.eye(dim)
+        self.pc, self.ps = np.zeros(dim), np.zeros(dim)
+        self.B, self.D = np.eye(dim), np.ones(dim)
+
+    def ask(self, rng):
+        """lam steps y (in the mean's frame) and the candidates mean + sigma y."""
+        y = rng.standard_normal((self.lam, self.dim)) @ (self.B * self.D).T
+        return y, self.mean + self.sigma * y
+
+    def tell(self, y, order):
+        """Updates mean, paths, covariance and step from the steps ranked best first."""
+        self.gen += 1
+        ysel = y[order[:self.mu]]
+        old = self.mean
+        self.mean = np.clip(self.mean + self.sigma * (self.w @ ysel), self.lo, self.hi)
+        yw = (self.mean - old) / self.sigma
+        invsqrt = self.B @ np.diag(1 / self.D) @ self.B.T
+        cs, cc, mueff = self.cs, self.cc, self.mueff
+        self.ps = (1 - cs) * self.ps + math.sqrt(cs * (2 - cs) * mueff) * (invsqrt @ yw)
+        hsig = (np.linalg.norm(self.ps) / math.sqrt(1 - (1 - cs) ** (2 * self.gen)) / self.chin
+                < 1.4 + 2 / (self.dim + 1))
+        self.pc = (1 - cc) * self.pc + hsig * math.sqrt(cc * (2 - cc) * mueff) * yw
+        self.C = ((1 - self.c1 - self.cmu) * self.C
+                  + self.c1 * (np.outer(self.pc, self.pc) + (not hsig) * cc * (2 - cc) * self.C)
+                  + self.cmu * (ysel.T * self.w) @ ysel)
+        self.sigma *= math.exp((cs / self.damps) * (np.linalg.norm(self.ps) / self.chin - 1))
+        self.C = np.triu(self.C) + np.triu(self.C, 1).T
+        D2, self.B = np.linalg.eigh(self.C)
+        self.D = np.sqrt(np.maximum(D2, 1e-20))
+
+
+def search(a, policy, x0, lo, hi, rng, tmp):
+    """Runs the CMA-ES for --evaluations episodes, a row of OUT/curve.csv per generation;
+    returns (best distance, its table, evaluations)."""
+    es = CmaEs(x0, a.sigma, lo, hi)
+    best, best_x, evals = -1.0, x0.copy(), 0
+    t0 = time.time()
+    with open(os.path.join(a.out, "curve.csv"), "w", newline="") as curve, \
+            concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
+        log = csv.writer(curve)
+        log.writerow(["generation", "evaluations", "best_m", "generation_best_m", "generation_mean_m", "sigma_m"])
+        while evals < a.evaluations:
+            y, xs = es.ask(rng)
+            scores = list(pool.map(lambda i: play(a.tensegrity, policy, xs[i], lo, hi, tmp, i)[0], range(es.lam)))
+            evals += es.lam
+            order = np.argsort(scores)[::-1]
+            if scores[order[0]] > best:
+                best, best_x = scores[order[0]], np.clip(xs[order[0]], lo, hi)
+            es.tell(y, order)
+            log.writerow([es.gen, evals, f"{best:.4f}", f"{scores[order[0]]:.4f}",
+                          f"{np.mean(scores):.4f}", f"{es.sigma:.5f}"])
+            curve.flush()
+            rate = evals / (time.time() - t0)
+            print(f"\rgen {es.gen} evals {evals} best {best:.2f} m gen mean {np.mean(scores):.2f} m "
+                  f"sigma {es.sigma:.4f} {rate:.1f} ev/s", end="", file=sys.stderr, flush=True)
+    print(file=sys.stderr)
+    return best, best_x, evals
+
+
+def main():
+    a = parse_args()
     with open(a.start) as f:
         policy = json.load(f)
     with open(policy_robot_path(a.start, policy)) as f:
@@ -67,68 +149,13 @@ def main():
     lo, hi = rest_length_limits(robot)
     n = policy["complexity"]
     x0 = np.array([v for c in policy["cables"] for v in c["rest_lengths_m"]], dtype=float)
-    dim = x0.size
     rng = np.random.default_rng(a.seed)
     if a.random_start:
-        x0 = rng.uniform(lo, hi, dim)
+        x0 = rng.uniform(lo, hi, x0.size)
     os.makedirs(a.out, exist_ok=True)
-
-    # Hansen's default strategy parameters.
-    lam = 4 + int(3 * math.log(dim))
-    mu = lam // 2
-    w = np.log(mu + 0.5) - np.log(np.arange(1, mu + 1))
-    w /= w.sum()
-    mueff = 1.0 / np.sum(w ** 2)
-    cc = (4 + mueff / dim) / (dim + 4 + 2 * mueff / dim)
-    cs = (mueff + 2) / (dim + mueff + 5)
-    c1 = 2 / ((dim + 1.3) ** 2 + mueff)
-    cmu = min(1 - c1, 2 * (mueff - 2 + 1 / mueff) / ((dim + 2) ** 2 + mueff))
-    damps = 1 + 2 * max(0, math.sqrt((mueff - 1) / (dim + 1)) - 1) + cs
-    chin = math.sqrt(dim) * (1 - 1 / (4 * dim) + 1 / (21 * dim * dim))
-
-    mean, sigma = x0.copy(), a.sigma
-    C = np.eye(dim)
-    pc, ps = np.zeros(dim), np.zeros(dim)
-    B, D = np.eye(dim), np.ones(dim)
-    best, best_x, evals, gen = -1.0, x0.copy(), 0, 0
-    t0 = time.time()
-    curve = open(os.path.join(a.out, "curve.csv"), "w", newline="")
-    log = csv.writer(curve)
-    log.writerow(["generation", "evaluations", "best_m", "generation_best_m", "generation_mean_m", "sigma_m"])
-    with tempfile.TemporaryDirectory() as tmp, \
-            concurrent.futures.ThreadPoolExecutor(a.jobs) as pool:
-        while evals < a.evaluations:
-            z = rng.standard_normal((lam, dim))
-            y = z @ (B * D).T
-            xs = mean + sigma * y
-            scores = list(pool.map(lambda i: play(a.binary, policy, xs[i], lo, hi, tmp, i)[0], range(lam)))
-            evals += lam
-            gen += 1
-            order = np.argsort(scores)[::-1]
-            if scores[order[0]] > best:
-                best, best_x = scores[order[0]], np.clip(xs[order[0]], lo, hi)
-            ysel = y[order[:mu]]
-            old = mean
-            mean = np.clip(mean + sigma * (w @ ysel), lo, hi)
-            yw = (mean - old) / sigma
-            invsqrt = B @ np.diag(1 / D) @ B.T
-            ps = (1 - cs) * ps + math.sqrt(cs * (2 - cs) * mueff) * (invsqrt @ yw)
-            hsig = np.linalg.norm(ps) / math.sqrt(1 - (1 - cs) ** (2 * gen)) / chin < 1.4 + 2 / (dim + 1)
-            pc = (1 - cc) * pc + hsig * math.sqrt(cc * (2 - cc) * mueff) * yw
-            C = ((1 - c1 - cmu) * C + c1 * (np.outer(pc, pc) + (not hsig) * cc * (2 - cc) * C)
-                 + cmu * (ysel.T * w) @ ysel)
-            sigma *= math.exp((cs / damps) * (np.linalg.norm(ps) / chin - 1))
-            C = np.triu(C) + np.triu(C, 1).T
-            D2, B = np.linalg.eigh(C)
-            D = np.sqrt(np.maximum(D2, 1e-20))
-            log.writerow([gen, evals, f"{best:.4f}", f"{scores[order[0]]:.4f}",
-                          f"{np.mean(scores):.4f}", f"{sigma:.5f}"])
-            curve.flush()
-            rate = evals / (time.time() - t0)
-            print(f"\rgen {gen} evals {evals} best {best:.2f} m gen mean {np.mean(scores):.2f} m "
-                  f"sigma {sigma:.4f} {rate:.1f} ev/s", end="", file=sys.stderr, flush=True)
-        _, report = play(a.binary, policy, best_x, lo, hi, tmp, "best")
-    print(file=sys.stderr)
+    with tempfile.TemporaryDirectory() as tmp:
+        best, best_x, evals = search(a, policy, x0, lo, hi, rng, tmp)
+        _, report = play(a.tensegrity, policy, best_x, lo, hi, tmp, "best")
     out = copy.deepcopy(policy)
     for i, cable in enumerate(out["cables"]):
         cable["rest_lengths_m"] = [float(v) for v in best_x[i * n:(i + 1) * n]]
@@ -142,8 +169,7 @@ def main():
 
 
 def policy_robot_path(policy_path, policy):
-    here = os.path.dirname(os.path.abspath(__file__))
-    return os.path.join(here, "..", "robots", policy["robot"] + ".json")
+    return os.path.join(program.ROOT, "robots", policy["robot"] + ".json")
 
 
 def rest_length_limits(robot):

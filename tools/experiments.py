@@ -28,32 +28,22 @@ Examples:
 """
 import argparse
 import concurrent.futures
-import csv
 import json
 import os
 import pathlib
-import statistics
-import subprocess
 import sys
 import threading
 import time
 
-import sweep_figure
-from experiment_pins import pin_robot, pin_settings
-
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-
-# What the paper reports (Iscen et al., sections 5-6), for the plots and the page.
-PAPER_PERIOD_M = {4: 33.0, 5: 27.0, 6: 22.5, 7: 19.0, 8: 18.0}
-PAPER_BEST_T4_N5_M = 32.0
+from tensegrity_tools import experiment_figures, program, runs
+from tensegrity_tools.experiment_pins import pin_robot, pin_settings
 
 
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", default="out/experiments", help="output directory (default: %(default)s)")
-    p.add_argument("--tensegrity", default=str(ROOT / "build/release/cli/tensegrity"),
-                   help="the tensegrity program (default: %(default)s)")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
+    program.add_option(p)
+    p.add_argument("--robot", default=str(program.ROOT / "robots/superball-paper.json"),
                    help="robot description (default: the default robot, the paper's simulated SUPERball)")
     p.add_argument("--seeds", type=int, default=5, help="seeds per configuration, 1..N (default: %(default)s)")
     p.add_argument("--method-seeds", type=int, default=None,
@@ -146,7 +136,7 @@ def run_one(a, key, r, progress):
         progress(key, "done already")
         return
     ckpt = d / "checkpoint"
-    cmd = [a.tensegrity, "evolve", "--robot", a.robot, "--method", r["method"], "--period", f"{r['period']:g}",
+    cmd = ["evolve", "--robot", a.robot, "--method", r["method"], "--period", f"{r['period']:g}",
            "--complexity", str(r["complexity"]), "--episodes", str(r["episodes"]), "--seed", str(r["seed"]),
            "--duration", f"{a.duration:g}", "--threads", "1", "--checkpoint", str(ckpt), "--out", str(d / "policy.json"),
            "--log", str(d / "curve.csv"), "--json"] + a.step_args
@@ -154,10 +144,10 @@ def run_one(a, key, r, progress):
         cmd.append("--resume")
     progress(key, "started")
     t0 = time.monotonic()
-    done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if done.returncode != 0:
-        raise RuntimeError(f"{key}: tensegrity evolve failed ({done.returncode}): {done.stderr.strip()}")
-    result = json.loads(done.stdout)
+    try:
+        result = program.run(a.tensegrity, cmd)
+    except program.RunError as e:  # an exception, not an exit: one failed run must not stop the others
+        raise RuntimeError(f"{key}: {e}") from None
     result.update(r)
     tmp = summary.with_suffix(".tmp")
     tmp.write_text(json.dumps(result, indent=2) + "\n")
@@ -187,17 +177,13 @@ def run_all(a, runs):
     return failures
 
 
-def read_curve(path):
-    with open(path) as f:
-        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
-
-
-def load(a, runs):
+def load(a, planned):
     out = {}
-    for key, r in runs.items():
+    for key, r in planned.items():
         d = pathlib.Path(a.out) / "runs" / key
         if (d / "summary.json").exists():
-            out[key] = dict(r, summary=json.loads((d / "summary.json").read_text()), curve=read_curve(d / "curve.csv"))
+            out[key] = dict(r, summary=json.loads((d / "summary.json").read_text()),
+                            curve=runs.read_curve(d / "curve.csv"))
     return out
 
 
@@ -220,148 +206,33 @@ def finished_runs(a):
     return found
 
 
-def mean_sd(values):
-    if not values:
-        return float("nan"), float("nan")
-    return statistics.fmean(values), (statistics.stdev(values) if len(values) > 1 else 0.0)
-
-
-def curves_by_generation(done, method, period, complexity, episodes, column):
-    """Per generation: episodes, mean and sd over the seeds that reached it."""
-    series = [d["curve"] for d in done.values()
-              if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)]
-    rows = []
-    for g in range(max((len(c) for c in series), default=0)):
-        vals = [c[g][column] for c in series if g < len(c)]
-        eps = next(c[g]["episodes"] for c in series if g < len(c))
-        m, sd = mean_sd(vals)
-        rows.append((g + 1, eps, m, sd, len(vals)))
-    return rows
-
-
-def finals(done, method, period, complexity, episodes):
-    return [d["summary"]["final_score_m"] for d in done.values()
-            if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)]
-
-
-def seed_finals(done, method, period, complexity, episodes):
-    return {d["seed"]: d["summary"]["final_score_m"] for d in done.values()
-            if (d["method"], d["period"], d["complexity"], d["episodes"]) == (method, period, complexity, episodes)}
-
-
-def write_csv(path, header, rows):
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        w.writerows(rows)
-
-
-def report(a, runs):
-    drawn = {**finished_runs(a), **runs}  # what the page shows: asked for now, or finished before
-    done = load(a, drawn)
-    out = pathlib.Path(a.out)
-    summary = {"episodes": a.episodes, "sweep_episodes": a.sweep_episodes, "seeds": a.seeds,
-               "method_seeds": a.method_seeds, "sweep_seeds": a.sweep_seeds, "robot": a.robot}
+def pyplot():
     try:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        return plt
     except ImportError:
-        plt = None
         print("experiments: matplotlib missing (Debian: python3-matplotlib; run with /usr/bin/python3): CSV only",
               file=sys.stderr)
+        return None
 
+
+def report(a, planned):
+    """The figures and summary.json from what is asked for now and what finished before."""
+    drawn = {**finished_runs(a), **planned}
+    done = load(a, drawn)
+    out, plt = pathlib.Path(a.out), pyplot()
+    summary = {"episodes": a.episodes, "sweep_episodes": a.sweep_episodes, "seeds": a.seeds,
+               "method_seeds": a.method_seeds, "sweep_seeds": a.sweep_seeds, "robot": a.robot}
     if 6 in a.figures:
-        rows, fig_data, summary["methods"] = [], {}, {}
-        for m in ("historical", "leniency", "average"):
-            best = curves_by_generation(done, m, 4.0, 5, a.episodes, "best_so_far_m")
-            mean = curves_by_generation(done, m, 4.0, 5, a.episodes, "mean_score_m")
-            fig_data[m] = (best, mean)
-            for b, mm in zip(best, mean):
-                rows.append((m, b[0], int(b[1]), f"{b[2]:.4f}", f"{b[3]:.4f}", f"{mm[2]:.4f}", f"{mm[3]:.4f}", b[4]))
-            f_mean, f_sd = mean_sd(finals(done, m, 4.0, 5, a.episodes))
-            last_mean = mean[-1][2] if mean else float("nan")
-            summary["methods"][m] = {"best_m": f_mean, "best_sd_m": f_sd, "last_generation_mean_m": last_mean,
-                                     "runs": len(finals(done, m, 4.0, 5, a.episodes))}
-        write_csv(out / "fig6_methods.csv", ["method", "generation", "episodes", "best_so_far_m", "best_so_far_sd_m",
-                                             "mean_score_m", "mean_score_sd_m", "seeds"], rows)
-        if plt:
-            fig, ax = plt.subplots(figsize=(8, 5))
-            for m, colour in zip(fig_data, ("C0", "C1", "C2")):
-                best, mean = fig_data[m]
-                if not best:
-                    continue
-                x = [r[1] for r in best]
-                ax.plot(x, [r[2] for r in best], color=colour, label=f"{m}: best so far")
-                ax.fill_between(x, [r[2] - r[3] for r in best], [r[2] + r[3] for r in best], color=colour, alpha=0.15)
-                ax.plot(x, [r[2] for r in mean], color=colour, linestyle="--", label=f"{m}: mean of generation")
-            ax.set_xlabel("episodes")
-            ax.set_ylabel("distance in 60 s, m")
-            seeds = {m: summary["methods"][m]["runs"] for m in fig_data}
-            ax.set_title(f"Figure 6: fitness methods (t = 4 s, n = 5; seeds: historical {seeds['historical']}, "
-                         f"leniency {seeds['leniency']}, average {seeds['average']}; band = 1 sd)")
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=8)
-            fig.tight_layout()
-            fig.savefig(out / "fig6_methods.png", dpi=110)
-            plt.close(fig)
-
+        summary["methods"] = experiment_figures.figure6(done, a.episodes, out, plt)
     if 7 in a.figures:
-        best = curves_by_generation(done, "historical", 4.0, 5, a.episodes, "best_so_far_m")
-        inf = curves_by_generation(done, "historical", 4.0, 5, a.episodes, "infeasible_rate")
-        write_csv(out / "fig7_learning.csv", ["generation", "episodes", "best_so_far_m", "best_so_far_sd_m",
-                                              "infeasible_rate", "infeasible_rate_sd", "seeds"],
-                  [(b[0], int(b[1]), f"{b[2]:.4f}", f"{b[3]:.4f}", f"{i[2]:.4f}", f"{i[3]:.4f}", b[4])
-                   for b, i in zip(best, inf)])
-        f_mean, f_sd = mean_sd(finals(done, "historical", 4.0, 5, a.episodes))
-        reach = [next((int(r["episodes"]) for r in d["curve"] if r["best_so_far_m"] >= PAPER_BEST_T4_N5_M), None)
-                 for d in done.values()
-                 if (d["method"], d["period"], d["complexity"], d["episodes"]) == ("historical", 4.0, 5, a.episodes)]
-        summary["learning"] = {"best_m": f_mean, "best_sd_m": f_sd, "paper_m": PAPER_BEST_T4_N5_M,
-                               "episodes_to_32m": reach,
-                               "infeasible_rate_last": inf[-1][2] if inf else None}
-        if plt and best:
-            fig, ax = plt.subplots(figsize=(8, 5))
-            x = [r[1] for r in best]
-            ax.errorbar(x, [r[2] for r in best], yerr=[r[3] for r in best], color="C0", errorevery=max(1, len(x) // 20),
-                        capsize=2, label="best so far, m")
-            ax.axhline(PAPER_BEST_T4_N5_M, color="grey", linestyle=":", label="paper: 32 m")
-            ax.set_xlabel("episodes")
-            ax.set_ylabel("distance in 60 s, m")
-            ax2 = ax.twinx()
-            ax2.plot(x, [100 * r[2] for r in inf], color="C3", alpha=0.7, label="infeasible, %")
-            ax2.set_ylabel("infeasible teams, %")
-            ax2.set_ylim(0, 100)
-            h1, l1 = ax.get_legend_handles_labels()
-            h2, l2 = ax2.get_legend_handles_labels()
-            ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="center right")
-            ax.set_title(f"Figure 7: learning, historical average, t = 4 s, n = 5 ({len(reach)} seeds)")
-            ax.grid(alpha=0.3)
-            fig.tight_layout()
-            fig.savefig(out / "fig7_learning.png", dpi=110)
-            plt.close(fig)
-
-    def sweep(name, fig_no, keys, label, paper):
-        points = [(x, sweep_figure.point(seed_finals(done, "historical", period, n, a.sweep_episodes)))
-                  for x, (period, n) in keys]
-        sweep_figure.write_csv(out / f"fig{fig_no}_{name}.csv", label, points, paper)
-        summary[name] = {f"{x:g}": {k: v for k, v in p.items() if k != "per_seed"} for x, p in points}
-        if plt:
-            sweep_figure.plot(plt, out / f"fig{fig_no}_{name}.png", f"Figure {fig_no}: {name}", label, points,
-                              paper, a.sweep_episodes)
-
-    def swept(field, asked, fixed):
-        found = {d[field] for d in done.values() if d["method"] == "historical"
-                 and d["episodes"] == a.sweep_episodes and fixed(d)}
-        return sorted(set(asked) | found)
-
+        summary["learning"] = experiment_figures.figure7(done, a.episodes, out, plt)
     if 8 in a.figures:
-        periods = swept("period", a.periods, lambda d: d["complexity"] == 5)
-        sweep("period", 8, [(t, (t, 5)) for t in periods], "period_s", PAPER_PERIOD_M)
+        summary["period"] = experiment_figures.figure8(done, a.sweep_episodes, a.periods, out, plt)
     if 9 in a.figures:
-        complexities = swept("complexity", a.complexities, lambda d: d["period"] == 4.0)
-        sweep("complexity", 9, [(n, (4.0, n)) for n in complexities], "complexity", {})
-
+        summary["complexity"] = experiment_figures.figure9(done, a.sweep_episodes, a.complexities, out, plt)
     summary["runs_done"], summary["runs_planned"] = len(done), len(drawn)
     (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     print(json.dumps(summary, indent=2))
@@ -374,9 +245,7 @@ def main():
     failures = []
     if not a.plot_only:
         pin_robot(a)
-        if not os.access(a.tensegrity, os.X_OK):
-            sys.exit(f"experiments: {a.tensegrity} is not an executable (build: cmake --preset release && "
-                     f"cmake --build --preset release --target tensegrity)")
+        a.tensegrity = program.find(a.tensegrity)
         pin_settings(a)
         print(f"experiments: {len(runs)} runs, {a.jobs} at a time, into {a.out}", flush=True)
         failures = run_all(a, runs)

@@ -37,12 +37,12 @@ import argparse
 import csv
 import json
 import os
-import subprocess
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+from tensegrity_tools import program
+
+ROOT = str(program.ROOT)
 
 
 def parse_set(text, count):
@@ -56,33 +56,18 @@ def parse_set(text, count):
     return sorted(set(picked))
 
 
-def find_tensegrity(given):
-    if given:
-        return given
-    for preset in ("release", "default"):
-        path = os.path.join(ROOT, "build", preset, "cli", "tensegrity")
-        if os.path.exists(path):
-            return path
-    raise SystemExit("tensegrity not found: build it (cmake --preset release && cmake --build --preset release "
-                     "--target tensegrity endcap) or pass --tensegrity PATH")
-
-
 def run_one(args, cable, failure="drive"):
-    cmd = [args.tensegrity, "hil", "--json", "--duration", str(args.duration), "--mode", args.mode,
+    cmd = ["hil", "--json", "--duration", str(args.duration), "--mode", args.mode,
            "--provision", args.provision]
     if args.policy:
         cmd += ["--policy", args.policy]
     if cable is not None:
         cmd += ["--disable-cable", str(cable), "--cable-failure", failure]
     started = time.monotonic()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
+    result = program.run(args.tensegrity, cmd, cwd=ROOT)
     wall = time.monotonic() - started
-    try:
-        result = json.loads(proc.stdout)
-    except json.JSONDecodeError:
-        raise SystemExit(f"{' '.join(cmd)}: exit {proc.returncode}, no JSON:\n{proc.stderr[-2000:]}")
     if not result.get("ok"):
-        raise SystemExit(f"{' '.join(cmd)}: {result.get('error')}")
+        raise SystemExit(f"{program.command_text([args.tensegrity] + cmd)}: {result.get('error')}")
     # Lockstep is deterministic unless a frame was lost on the way (a loaded host):
     # kept with each run so an outlier can be told from a result.
     drops = sum(e.get("rx_drops", 0) + e.get("send_failures", 0) for e in result.get("endcaps", []))
@@ -153,7 +138,7 @@ def plot(out, rows, title):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--tensegrity", help="the tensegrity program (default: build/release or build/default)")
+    program.add_option(p)
     # The paper's Figure 13 is about the paper's robot, so the default is the 2014 file's
     # 5000-episode gait (a record since it skates), not whatever the HIL plays by default. docs/guide/hil.md's figure was made
     # with the 14,000-episode gait kept in docs/results/policies/ (give it as --policy).
@@ -175,7 +160,7 @@ def main():
     if args.plot_only:
         print(plot(args.out, read_csv(args.out), title))
         return
-    args.tensegrity = find_tensegrity(args.tensegrity)
+    args.tensegrity = program.find(args.tensegrity)
     owner = owners(args.robot)
     cables = parse_set(args.cables, len(owner)) if args.cables else list(range(len(owner)))
 

@@ -28,19 +28,17 @@ import csv
 import json
 import pathlib
 import statistics
-import subprocess
 import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from arm import ROOT, write_robot  # noqa: E402  (one way to apply --set for every tool)
+from tensegrity_tools import program, robot_file, runs
 
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--tensegrity", default=str(ROOT / "build/release/cli/tensegrity"), help="the program")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"), help="robot description")
-    p.add_argument("--set", action="append", default=[], metavar="PATH=JSON", help="change a robot field (repeatable)")
+    program.add_option(p)
+    p.add_argument("--robot", default=str(program.ROOT / "robots/superball-paper.json"), help="robot description")
+    robot_file.add_set_option(p)
     p.add_argument("--cable", type=int, default=3,
                    help="the cable pulled, 0-based (default: %(default)s, the 13th muscle of the author's NTRT model, "
                         "mapped onto this file's nodes: docs/design/model.md)")
@@ -72,26 +70,19 @@ def hold_policy(robot_doc, pulled=None, rest_length=None):
 
 
 def play(a, robot, policy_path, telemetry):
-    cmd = [a.tensegrity, "sim", "--robot", str(robot), "--policy", str(policy_path), "--start", "settled",
-           "--duration", f"{a.duration:g}", "--telemetry", str(telemetry), "--telemetry-every", "10", "--json"]
-    out = subprocess.run(cmd, capture_output=True, text=True)
-    if out.returncode != 0:
-        sys.exit(f"{' '.join(cmd)}: exit {out.returncode}: {out.stderr.strip()}")
-    return json.loads(out.stdout)
+    return program.sim(a.tensegrity, policy_path, robot, ["--start", "settled", "--duration", f"{a.duration:g}",
+                                                          "--telemetry", telemetry, "--telemetry-every", "10"])
 
 
 def mean_lengths(telemetry, cables, from_s):
     """Each cable's actual length averaged over the rows at or after from_s."""
-    sums, rows = [0.0] * cables, 0
-    with open(telemetry) as f:
-        for row in csv.DictReader(f):
-            if float(row["time_s"]) + 1e-9 >= from_s:
-                rows += 1
-                for i in range(cables):
-                    sums[i] += float(row[f"cable{i}_length_m"])
-    if rows == 0:
+    record = runs.read_record(telemetry)
+    if record.cable_count("length_m") != cables:
+        sys.exit(f"{telemetry}: {record.cable_count('length_m')} cables' lengths, the robot has {cables}")
+    late = [lengths for t, lengths in zip(record.times_s(), record.cables("length_m")) if t + 1e-9 >= from_s]
+    if not late:
         sys.exit(f"{telemetry}: no rows in the last {from_s} s")
-    return [s / rows for s in sums]
+    return [sum(column) / len(late) for column in zip(*late)]
 
 
 def verdict(change_m, tolerance_m):
@@ -180,7 +171,8 @@ def main(argv=None):
                  f"(cable.max_rest_length_m {longest:g})")
     if a.rest_length < shortest:
         a.set = a.set + [f"cable.min_rest_length_m={a.rest_length}"]
-    robot = write_robot(a, out)
+    a.tensegrity = program.find(a.tensegrity)
+    robot = robot_file.write_robot(a.robot, a.set, out)
     robot_doc = json.loads(robot.read_text())
     (out / "held-policy.json").write_text(json.dumps(hold_policy(robot_doc), indent=2) + "\n")
     held_result = play(a, robot, out / "held-policy.json", out / "held-telemetry.csv")

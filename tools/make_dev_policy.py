@@ -7,15 +7,18 @@ travelling wave sampled at the table's five subintervals.
 
 usage: tools/make_dev_policy.py OUT.json [robots/superball.json]
 """
+import argparse
 import json
 import math
-import sys
 
 
 def main():
-    out = sys.argv[1]
-    robot_path = sys.argv[2] if len(sys.argv) > 2 else "robots/superball.json"
-    with open(robot_path) as f:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("out", help="the policy file to write")
+    ap.add_argument("robot", nargs="?", default="robots/superball.json", help="robot file (default: %(default)s)")
+    args = ap.parse_args()
+    out = args.out
+    with open(args.robot) as f:
         robot = json.load(f)
     cables = []
     for m, c in enumerate(robot["cables"]):

@@ -25,16 +25,15 @@ import json
 import pathlib
 import random
 import statistics
-import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+from tensegrity_tools import program
 
 
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
+    program.add_option(p)
     p.add_argument("--gait", action="append", required=True, metavar="NAME=POLICY", help="a gait (repeatable)")
     p.add_argument("--robot", action="append", required=True, metavar="NAME=ROBOT", help="a robot (repeatable)")
     p.add_argument("--random", type=int, default=5, help="random tables per gait for the line probe")
@@ -88,11 +87,7 @@ def tables_for(gait_doc, rng, args, lo, hi):
 
 def play(args, doc, robot, path):
     path.write_text(json.dumps(doc))
-    cmd = ["nice", "-n", str(args.nice), args.tensegrity, "sim", "--robot", str(robot), "--policy", str(path), "--json"]
-    result = subprocess.run(cmd, capture_output=True, text=True)
-    if result.returncode != 0:
-        sys.exit(f"{' '.join(cmd)}: {result.stderr.strip()}")
-    return json.loads(result.stdout)["distance_m"]
+    return program.sim(args.tensegrity, path, robot, nice=args.nice)["distance_m"]
 
 
 def main():
@@ -105,6 +100,7 @@ def main():
         sys.exit(f"--steps {args.steps}: must be at least 1")
     if any(not 0 <= sigma <= 1 for sigma in args.sigma):
         sys.exit(f"--sigma {args.sigma}: each must lie in [0, 1] m")
+    args.tensegrity = program.find(args.tensegrity)
     gaits, robots = named(args.gait, "gait"), named(args.robot, "robot")
     lo, hi = limits(next(iter(robots.values())))
     out = pathlib.Path(args.out)

@@ -27,8 +27,9 @@ import csv
 import json
 import pathlib
 import statistics
-import subprocess
 import sys
+
+from tensegrity_tools import program, runs
 
 FIELDS = ["arm", "seed", "class", "distance_m", "revolutions", "turn_period_s", "contact_period_s", "faces",
           "distinct_faces", "back_steps", "face_cycle_match", "endcaps_on_ground", "mean_tension_n",
@@ -41,7 +42,7 @@ def parse_args():
                                 formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     p.add_argument("arms", nargs="+", help="arm directories written by tools/arm.py")
     p.add_argument("--out", required=True, help="directory for plateau.csv, plateau.json, plateau.png")
-    p.add_argument("--tensegrity", default="build/release/cli/tensegrity", help="the tensegrity program")
+    program.add_option(p)
     p.add_argument("--takeoff-m", type=float, default=20.0, help="a best team this far has left the plateau")
     p.add_argument("--roll-m", type=float, default=28.0, help="a gait this far rolls (the issue's 28 m)")
     p.add_argument("--duration", type=float, default=60.0, help="episode length of the replay, s")
@@ -54,12 +55,9 @@ def seeds_of(arm):
 
 
 def gait(a, arm, run):
-    r = subprocess.run([a.tensegrity, "analyze", str(run / "policy.json"), "--robot", str(arm / "robot.json"),
-                        "--duration", str(a.duration), "--out", str(pathlib.Path(a.out) / "analyze" / arm.name / run.name),
-                        "--no-plots", "--json"], capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"plateau: {run}: tensegrity analyze failed: {r.stderr.strip()[-400:]}")
-    d = json.loads(r.stdout)
+    d = program.run(a.tensegrity, ["analyze", run / "policy.json", "--robot", arm / "robot.json", "--duration",
+                                   a.duration, "--out", pathlib.Path(a.out) / "analyze" / arm.name / run.name,
+                                   "--no-plots", "--json"])
     e, ro, period = d["episode"], d["rolling"], d["revolution_period_s"]
     faces = [tuple(f) for f in ro["face_sequence"]]
     # The analyzer gives 0 for a period it cannot measure (a gait that never turns): none.
@@ -72,15 +70,10 @@ def gait(a, arm, run):
 
 
 def takeoff(a, curve_csv):
-    with open(curve_csv) as f:
-        rows = list(csv.DictReader(f))
     out = {k: None for k in FIELDS[-5:]}
     before = 0.0
-    for line, r in enumerate(rows, start=2):
-        try:
-            best, mean = float(r["best_so_far_m"]), float(r["mean_score_m"])
-        except (KeyError, TypeError, ValueError) as e:
-            sys.exit(f"plateau: {curve_csv}, line {line}: best_so_far_m and mean_score_m must be numbers ({e!r})")
+    for r in runs.read_curve(curve_csv):
+        best, mean = r["best_so_far_m"], r["mean_score_m"]
         if best >= a.takeoff_m and out["takeoff_episode"] is None:
             out.update(takeoff_episode=int(r["episodes"]), best_before_takeoff_m=before, best_at_takeoff_m=best,
                        generation_mean_at_takeoff_m=mean)
@@ -143,6 +136,7 @@ def plot(a, rows):
 
 def main():
     a = parse_args()
+    a.tensegrity = program.find(a.tensegrity)
     out = pathlib.Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []

@@ -8,13 +8,13 @@ Each curve is LABEL=FILE:XCOLUMN:YCOLUMN[:XOFFSET] (XOFFSET is added to x), e.g.
 """
 
 import argparse
-import csv
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from tensegrity_tools import runs  # noqa: E402
 
 
 def main():
@@ -41,11 +41,8 @@ def main():
             offset = float(parts[3]) if len(parts) == 4 else 0.0
         except ValueError:
             sys.exit(f"{spec}: XOFFSET {parts[3]!r} is not a number")
-        with open(path, newline="") as f:
-            rows = list(csv.DictReader(f))
-        if not rows or xcol not in rows[0] or ycol not in rows[0]:
-            sys.exit(f"{path}: no column {xcol!r} or {ycol!r} (has {list(rows[0]) if rows else 'no rows'})")
-        ax.plot([float(r[xcol]) + offset for r in rows], [float(r[ycol]) for r in rows], label=label or path)
+        rows = runs.read_table(path, (xcol, ycol), f"a curve with columns {xcol} and {ycol}")
+        ax.plot([r[xcol] + offset for r in rows], [r[ycol] for r in rows], label=label or path)
     for y in a.hline:
         ax.axhline(y, color="grey", linestyle="--", linewidth=1)
     ax.set_xlabel(a.xlabel)

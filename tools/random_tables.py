@@ -23,11 +23,9 @@ import json
 import pathlib
 import random
 import statistics
-import subprocess
 import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from arm import ROOT, write_robot  # noqa: E402  (one way to apply --set for both tools)
+from tensegrity_tools import program, robot_file
 
 FIELDS = ["table", "distance_m", "feasible", "max_tension_n", "mean_tension_n", "endcaps_touched_ground",
           "axial_spin_rms_rad_per_s", "min_strut_gap_m", "strut_overlap_s"]
@@ -36,10 +34,10 @@ FIELDS = ["table", "distance_m", "feasible", "max_tension_n", "mean_tension_n", 
 def parse_args():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--tensegrity", default=str(ROOT / "build/default/cli/tensegrity"), help="the program")
-    p.add_argument("--robot", default=str(ROOT / "robots/superball-paper.json"),
+    program.add_option(p)
+    p.add_argument("--robot", default=str(program.ROOT / "robots/superball-paper.json"),
                    help="robot description (default: the default robot, the paper's simulated SUPERball)")
-    p.add_argument("--set", action="append", default=[], metavar="PATH=JSON", help="change a robot field (repeatable)")
+    robot_file.add_set_option(p)
     p.add_argument("--tables", type=int, default=120, help="random tables (default: %(default)s)")
     p.add_argument("--seed", type=int, default=1, help="seed of the tables (default: %(default)s)")
     p.add_argument("--period", type=float, default=4.0, help="policy period, s (default: %(default)s)")
@@ -53,14 +51,6 @@ def table(rng, robot_doc, complexity):
     lo, hi = robot_doc["cable"]["min_rest_length_m"], robot_doc["cable"]["max_rest_length_m"]
     return [{"cable": i, "owner": c["owner"], "rest_lengths_m": [rng.uniform(lo, hi) for _ in range(complexity)]}
             for i, c in enumerate(robot_doc["cables"])]
-
-
-def play(args, robot, path):
-    cmd = [args.tensegrity, "sim", "--robot", str(robot), "--policy", str(path), "--json", "--start", args.start]
-    out = subprocess.run(cmd, capture_output=True, text=True)
-    if out.returncode != 0:
-        sys.exit(f"{' '.join(cmd)}: exit {out.returncode}: {out.stderr.strip()}")
-    return json.loads(out.stdout)
 
 
 def quantile(values, q):
@@ -88,7 +78,8 @@ def main():
     args = parse_args()
     out = pathlib.Path(args.out)
     (out / "tables").mkdir(parents=True, exist_ok=True)
-    robot = write_robot(args, out)
+    args.tensegrity = program.find(args.tensegrity)
+    robot = robot_file.write_robot(args.robot, args.set, out)
     robot_doc = json.loads(robot.read_text())
     rng = random.Random(args.seed)
     paths = []
@@ -100,7 +91,7 @@ def main():
         paths.append(path)
     rows = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for i, result in enumerate(pool.map(lambda p: play(args, robot, p), paths)):
+        for i, result in enumerate(pool.map(lambda p: program.sim(args.tensegrity, p, robot, ["--start", args.start]), paths)):
             rows.append({"table": i, **{k: result[k] for k in FIELDS[1:]}})
             if (i + 1) % 20 == 0:
                 print(f"  {i + 1}/{args.tables} tables played", file=sys.stderr, flush=True)

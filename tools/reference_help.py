@@ -4,24 +4,24 @@
 so that the reference is what the program prints: under each "## SUBCOMMAND" heading,
 the first ```text block is replaced. `--check` exits 1 naming the sections that differ.
 
-  tools/reference_help.py PATH/TO/tensegrity [--check]
+  tools/reference_help.py [--tensegrity BIN] [--check]
 """
 import argparse
-import pathlib
 import re
-import subprocess
 import sys
 
-DOC = pathlib.Path(__file__).resolve().parent.parent / "docs" / "reference" / "tensegrity.md"
+from tensegrity_tools import program
+
+DOC = program.ROOT / "docs" / "reference" / "tensegrity.md"
 
 
-def help_text(program, words):
-    out = subprocess.run([program, *words, "--help"], capture_output=True, text=True, check=True).stdout
+def help_text(binary, words):
+    out = program.text(binary, [*words, "--help"])
     # The program names itself by the path it was started with; the reference by its name.
     return re.sub(r"^Usage: \S*tensegrity", "Usage: tensegrity", out, flags=re.M).rstrip("\n")
 
 
-def rewrite(text, program):
+def rewrite(text, binary):
     sections = re.split(r"(?m)^(## .+)$", text)
     changed = []
     for i in range(1, len(sections), 2):
@@ -30,7 +30,7 @@ def rewrite(text, program):
         m = re.search(r"```text\n(.*?)\n```", body, flags=re.S)
         if not m:
             continue
-        new = help_text(program, words)
+        new = help_text(binary, words)
         if new != m.group(1):
             changed.append(" ".join(words))
             sections[i + 1] = body[:m.start(1)] + new + body[m.end(1):]
@@ -39,10 +39,10 @@ def rewrite(text, program):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("program")
+    program.add_option(ap)
     ap.add_argument("--check", action="store_true", help="only say which sections differ (exit 1 if any)")
     args = ap.parse_args()
-    text, changed = rewrite(DOC.read_text(), args.program)
+    text, changed = rewrite(DOC.read_text(), program.find(args.tensegrity))
     if args.check:
         for c in changed:
             print(f"reference: `tensegrity {c} --help` differs from {DOC.name}", file=sys.stderr)

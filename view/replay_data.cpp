@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "sim/model/telemetry.hpp"
 #include "view/csv_table.hpp"
 #include "view/json_numbers.hpp"
 
@@ -57,16 +58,16 @@ ReplayFrames ReplayBuilder::take() {
 
 namespace {
 
-// Column indices of one quantity, one per node coordinate or cable; throws naming
-// the first missing column and both accepted spellings.
+// Column indices of one quantity, one per cable; throws naming the first missing
+// column and both accepted spellings (a HIL record of an older version has the second).
 std::vector<int> cable_columns(const CsvHeader& h, int cables, const char* what) {
   std::vector<int> out;
   for (int m = 0; m < cables; ++m) {
-    const std::string sim_name = "cable" + std::to_string(m) + "_" + what;
-    const std::string hil_name = std::string(what) + "_" + std::to_string(m);
-    int i = h.find(sim_name);
-    if (i < 0) i = h.find(hil_name);
-    if (i < 0) throw InputError(h.source + ":1: no column " + sim_name + " (or " + hil_name + ")");
+    const std::string name = sim::cable_column(m, what);
+    const std::string legacy = sim::legacy_cable_column(m, what);
+    int i = h.find(name);
+    if (i < 0) i = h.find(legacy);
+    if (i < 0) throw InputError(h.source + ":1: no column " + name + " (or " + legacy + ")");
     out.push_back(i);
   }
   return out;

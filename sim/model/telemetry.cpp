@@ -7,6 +7,14 @@
 
 namespace tensegrity::sim {
 
+std::string cable_column(int cable, std::string_view quantity) {
+  return "cable" + std::to_string(cable) + "_" + std::string(quantity);
+}
+
+std::string legacy_cable_column(int cable, std::string_view quantity) {
+  return std::string(quantity) + "_" + std::to_string(cable);
+}
+
 CsvTelemetry::CsvTelemetry(const std::string& path) : path_(path), out_(path) {
   if (!out_) throw std::runtime_error(path + ": cannot open telemetry file for writing");
   out_.precision(9);
@@ -18,7 +26,7 @@ void CsvTelemetry::begin(const Model& model) {
     out_ << ",node" << i << "_x_m,node" << i << "_y_m,node" << i << "_z_m";
   }
   for (const char* what : {"rest_length_m", "length_m", "tension_n", "power_w"}) {
-    for (int m = 0; m < model.cable_count(); ++m) out_ << ",cable" << m << "_" << what;
+    for (int m = 0; m < model.cable_count(); ++m) out_ << ',' << cable_column(m, what);
   }
   out_ << ",kinetic_energy_j,gravity_energy_j,elastic_energy_j\n";
 }

@@ -4,10 +4,19 @@
 // recorded step.
 #include <fstream>
 #include <string>
+#include <string_view>
 
 namespace tensegrity::sim {
 
 class Model;
+
+// A run record (`sim --telemetry`, `hil --record`) names one cable's quantity
+// cableM_QUANTITY: cable_column(3, "tension_n") is "cable3_tension_n". Both writers
+// use it, so the view and the tools read either record by the same names.
+std::string cable_column(int cable, std::string_view quantity);
+// The name HIL records of older versions used, QUANTITY_M ("tension_n_3"): readers
+// accept it too, so a record made then stays readable.
+std::string legacy_cable_column(int cable, std::string_view quantity);
 
 class TelemetrySink {
  public:

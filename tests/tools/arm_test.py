@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # SPDX-License-Identifier: Apache-2.0
-"""tools/arm_stats.py and tools/arm.py --compare on arms made up here.
+"""tools/tensegrity_tools/arm_stats.py and tools/arm.py --compare on arms made up here.
 
 Usage: arm_test.py TOOLS_DIR
 """
@@ -14,8 +14,7 @@ import unittest
 
 TOOLS = pathlib.Path(sys.argv.pop(1) if len(sys.argv) > 1 else pathlib.Path(__file__).parents[2] / "tools")
 sys.path.insert(0, str(TOOLS))
-import arm_keep  # noqa: E402
-import arm_stats  # noqa: E402
+from tensegrity_tools import arm_keep, arm_stats  # noqa: E402
 
 
 def write_arm(root, name, seeds):

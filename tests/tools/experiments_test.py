@@ -17,7 +17,7 @@ import unittest
 
 TOOLS = pathlib.Path(sys.argv.pop(1) if len(sys.argv) > 1 else pathlib.Path(__file__).parents[2] / "tools")
 sys.path.insert(0, str(TOOLS))
-import sweep_figure  # noqa: E402
+from tensegrity_tools import sweep_figure  # noqa: E402
 
 # Odd seeds roll 35 m, even seeds stay at 8 m plus the period: a bimodal point.
 FAKE_EVOLVE = r'''#!/usr/bin/python3

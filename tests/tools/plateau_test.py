@@ -78,7 +78,7 @@ class Plateau(unittest.TestCase):
             done = subprocess.run(["/usr/bin/python3", str(TOOLS / "plateau.py"), str(arm), "--out", tmp + "/out",
                                    "--tensegrity", str(TENSEGRITY)], capture_output=True, text=True)
             self.assertNotEqual(done.returncode, 0)
-            self.assertIn("curve.csv, line 3: best_so_far_m and mean_score_m must be numbers", done.stderr)
+            self.assertIn("curve.csv, line 3: best_score_m 'lost' is not a number", done.stderr)
 
     def test_a_directory_that_is_not_an_arm_is_named(self):
         with tempfile.TemporaryDirectory() as tmp:

@@ -8,6 +8,7 @@
 
 #include "sim/model/benchmark_policy.hpp"
 #include "sim/model/episode.hpp"
+#include "sim/model/telemetry.hpp"
 #include "view/csv_table.hpp"
 #include "view/replay_sink.hpp"
 
@@ -55,10 +56,15 @@ TEST(ReplayData, ReadsTheSimulatorsTelemetryAtTheFrameRate) {
   EXPECT_EQ(j["distance_m"][0], 0.0);
 }
 
-std::string hil_header(int nodes, int cables) {
+// A `hil --record` header; `legacy`: cable columns as HIL records of older versions
+// named them (tension_n_3 for cable3_tension_n).
+std::string hil_header(int nodes, int cables, bool legacy = false) {
   std::string h = "time_s,centre_x_m,centre_y_m,centre_z_m";
-  for (int c = 0; c < cables; ++c) h += ",rest_length_m_" + std::to_string(c);
-  for (int c = 0; c < cables; ++c) h += ",tension_n_" + std::to_string(c);
+  for (const char* what : {"rest_length_m", "tension_n"}) {
+    for (int c = 0; c < cables; ++c) {
+      h += "," + (legacy ? sim::legacy_cable_column(c, what) : sim::cable_column(c, what));
+    }
+  }
   for (int i = 0; i < nodes; ++i) {
     for (const char* a : {"x", "y", "z"}) h += ",node" + std::to_string(i) + "_" + a + "_m";
   }
@@ -75,17 +81,20 @@ std::string hil_row(double t, int nodes, int cables, double x) {
 
 TEST(ReplayData, ReadsAHilRecordWithoutEnergy) {
   const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
-  const auto path = temp("hil.csv");
-  std::ofstream(path) << hil_header(12, 24) << hil_row(0.0, 12, 24, 0.0) << hil_row(0.001, 12, 24, 0.01)
-                      << hil_row(0.03, 12, 24, 3.0);
-  std::vector<std::string> warnings;
-  const ReplayFrames f = load_replay_csv(path, robot, warnings);
-  EXPECT_FALSE(f.has_energy);
-  ASSERT_EQ(f.frames(), 2U);  // 0.001 s is closer than a frame to 0
-  EXPECT_FLOAT_EQ(f.tension_n[5], 105.0F);
-  const auto j = nlohmann::json::parse(replay_json(f, "hil.csv"));
-  EXPECT_TRUE(j["energy_j"].is_null());
-  EXPECT_NEAR(j["distance_m"][1].get<double>(), 3.0, 1e-4);
+  for (const bool legacy : {false, true}) {  // an older HIL record reads the same
+    const auto path = temp(legacy ? "hil-legacy.csv" : "hil.csv");
+    std::ofstream(path) << hil_header(12, 24, legacy) << hil_row(0.0, 12, 24, 0.0) << hil_row(0.001, 12, 24, 0.01)
+                        << hil_row(0.03, 12, 24, 3.0);
+    std::vector<std::string> warnings;
+    const ReplayFrames f = load_replay_csv(path, robot, warnings);
+    EXPECT_FALSE(f.has_energy);
+    ASSERT_EQ(f.frames(), 2U);  // 0.001 s is closer than a frame to 0
+    EXPECT_FLOAT_EQ(f.tension_n[5], 105.0F);
+    EXPECT_FLOAT_EQ(f.rest_length_m[5], 0.9F);
+    const auto j = nlohmann::json::parse(replay_json(f, "hil.csv"));
+    EXPECT_TRUE(j["energy_j"].is_null());
+    EXPECT_NEAR(j["distance_m"][1].get<double>(), 3.0, 1e-4);
+  }
 }
 
 std::string error_of(const std::filesystem::path& path) {

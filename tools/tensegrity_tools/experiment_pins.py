@@ -5,9 +5,10 @@ parameters alone, so a run made on another robot, or by a program whose defaults
 changed (population sizes, step schedule), must not be taken for this one's."""
 import json
 import pathlib
-import subprocess
 import sys
 import tempfile
+
+from . import program
 
 
 def pin_robot(a):
@@ -33,13 +34,13 @@ def pin_settings(a):
     that runs of another version's defaults are refused before hours are spent."""
     out = pathlib.Path(a.out)
     with tempfile.TemporaryDirectory() as tmp:
-        probe = subprocess.run([a.tensegrity, "evolve", "--robot", a.robot, "--episodes", "1", "--duration", "0.01",
-                                "--period", "4", "--complexity", "2", "--threads", "1", "--out", f"{tmp}/p.json",
-                                "--log", f"{tmp}/c.csv", "--json"] + a.step_args,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if probe.returncode != 0:
-        sys.exit(f"experiments: tensegrity evolve refused the settings: {probe.stderr.strip()}")
-    config = json.loads(probe.stdout).get("config", {})
+        try:
+            probe = program.run(a.tensegrity, ["evolve", "--robot", a.robot, "--episodes", "1", "--duration", "0.01",
+                                               "--period", "4", "--complexity", "2", "--threads", "1", "--out",
+                                               f"{tmp}/p.json", "--log", f"{tmp}/c.csv", "--json"] + a.step_args)
+        except program.RunError as e:
+            sys.exit(f"experiments: tensegrity evolve refused the settings: {e}")
+    config = probe.get("config", {})
     now = {k: config[k] for k in SETTINGS if k in config}
     # Keyed by the runs' step tag: runs with their own step options have their own ids.
     pinned, tag = out / "evolve-settings.json", a.mutation_tag or "default"
