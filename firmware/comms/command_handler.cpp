@@ -20,8 +20,7 @@ CommandHandler::CommandHandler(int endcap_id, std::uint16_t format_version, std:
       life_id_(life_id),
       log_(log) {}
 
-std::optional<CommandReason> CommandHandler::handle(const CommandSample& c, const SyncView& sync,
-                                                    std::int64_t now_ns) {
+std::optional<CommandReason> CommandHandler::handle(const CommandSample& c, const SyncView& sync, std::int64_t now_ns) {
   const auto host_now = checked_add(now_ns, sync.offset_ns);
   const HostClockView clock{sync.synced && host_now.has_value(), host_now.value_or(0)};
   // Only this thread counts estops (act_on): the count judged is the one the clear

@@ -44,16 +44,17 @@ EndcapNode::EndcapNode(const EndcapNodeConfig& config, Clock& clock, app::Policy
       sync_(random_seed(), log_),
       commands_(config_.endcap_id, msgs::kFormatVersion, core::seconds_to_ns(config_.command_max_age_s),
                 config_.start_grid_ns, std::random_device{}() | 1U, log_),
-      tables_(config_.expect, core::seconds_to_ns(config_.loop_ack_timeout_s), store,
-              [this](const PolicyTableMsg& msg, PolicyReason reason, const std::string& text) {
-                // On both participants during a rejoin's overlap: which one the host
-                // hears is not known, and an uploader takes the first ack of a
-                // sequence and ignores the rest.
-                m::PolicyAck_ ack = policy_ack_message(facts(), msg, reason, text);
-                participants_->current()->policy_ack->write(&ack);
-                if (NodeParticipant* old = participants_->retiring()) old->policy_ack->write(&ack);
-              },
-              log_),
+      tables_(
+          config_.expect, core::seconds_to_ns(config_.loop_ack_timeout_s), store,
+          [this](const PolicyTableMsg& msg, PolicyReason reason, const std::string& text) {
+            // On both participants during a rejoin's overlap: which one the host
+            // hears is not known, and an uploader takes the first ack of a
+            // sequence and ignores the rest.
+            m::PolicyAck_ ack = policy_ack_message(facts(), msg, reason, text);
+            participants_->current()->policy_ack->write(&ack);
+            if (NodeParticipant* old = participants_->retiring()) old->policy_ack->write(&ack);
+          },
+          log_),
       host_(config_.host_timeout_s, config_.host_boot_grace_s, config_.host_loss, msgs::kFormatVersion, log_),
       rejoin_(config_.endcap_id, config_.unheard_rejoin_s, log_),
       loop_watch_(config_.loop_progress, config_.loop_stall_timeout_s, log_),
@@ -99,7 +100,7 @@ app::LinkEvents EndcapNode::link_events() const noexcept {
 }
 
 NodeFacts EndcapNode::facts() const {
-  return {config_.endcap_id, tables_.active(), sync_.view(),           host_.lost(),
+  return {config_.endcap_id, tables_.active(),    sync_.view(),      host_.lost(),
           config_.host_loss, commands_.life_id(), commands_.estops()};
 }
 

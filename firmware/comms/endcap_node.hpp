@@ -90,8 +90,8 @@ class EndcapNode final : public app::HostLink {
   NodeFacts facts() const;
   // node_listeners.cpp: the participant and its listeners.
   std::unique_ptr<NodeParticipant> make_participant();  // throws msgs::DdsError
-  void on_commands(NodeParticipant& p);                   // Fast DDS's receive thread
-  void on_time_sync_reply(NodeParticipant& p);            // Fast DDS's receive thread
+  void on_commands(NodeParticipant& p);                 // Fast DDS's receive thread
+  void on_time_sync_reply(NodeParticipant& p);          // Fast DDS's receive thread
 
   EndcapNodeConfig config_;
   Clock& clock_;

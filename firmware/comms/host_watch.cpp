@@ -38,8 +38,8 @@ bool HostWatch::poll(std::int64_t now_ns) {
   if (lost == lost_) return false;
   lost_ = lost;
   (lost ? losses_ : returns_).fetch_add(1, std::memory_order_relaxed);
-  log_("host %s (configured action: %s)", lost ? (seen_ ? "LOST: no heartbeat" : "LOST: none heard since start") : "back",
-       to_string(action_));
+  log_("host %s (configured action: %s)",
+       lost ? (seen_ ? "LOST: no heartbeat" : "LOST: none heard since start") : "back", to_string(action_));
   if (lost && action_ == HostLossAction::stop) stops_.fetch_add(1, std::memory_order_acq_rel);
   return lost;
 }

@@ -40,8 +40,7 @@ class LoopWatch {
 class LinkFaultWatch {
  public:
   // Either may be null: that fault is never injected.
-  LinkFaultWatch(const std::atomic<bool>* link_cut, const std::atomic<std::uint32_t>* mute_requests,
-                 const NodeLog& log)
+  LinkFaultWatch(const std::atomic<bool>* link_cut, const std::atomic<std::uint32_t>* mute_requests, const NodeLog& log)
       : link_cut_(link_cut), mute_requests_(mute_requests), log_(log) {}
 
   // Logs a cut or a restored link; true when a new mute was asked for, which the

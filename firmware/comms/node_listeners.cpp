@@ -83,7 +83,7 @@ std::unique_ptr<NodeParticipant> EndcapNode::make_participant() {
 
 void EndcapNode::on_commands(NodeParticipant& d) {
   std::lock_guard guard(d.callback_mutex);
-  if (d.closed || d.command == nullptr) return;     // stopping, or still starting (taken next time)
+  if (d.closed || d.command == nullptr) return;   // stopping, or still starting (taken next time)
   std::lock_guard serial(participants_->serial);  // the other participant's listener, after a rejoin
   m::Command_ cmd;
   dds::SampleInfo info;

@@ -37,7 +37,7 @@ tensegrity_msgs::msg::dds_::CommandAck_ command_ack_message(const NodeFacts& fac
 // `local_ns`: the node clock when the loop published `t`; host time only once synced.
 tensegrity_msgs::msg::dds_::Telemetry_ telemetry_message(const NodeFacts& facts, std::uint32_t seq,
                                                          const app::Telemetry& t, std::int64_t local_ns);
-tensegrity_msgs::msg::dds_::Heartbeat_ heartbeat_message(const NodeFacts& facts, std::uint32_t seq,
-                                                         std::int64_t now_ns, const app::Telemetry& t);
+tensegrity_msgs::msg::dds_::Heartbeat_ heartbeat_message(const NodeFacts& facts, std::uint32_t seq, std::int64_t now_ns,
+                                                         const app::Telemetry& t);
 
 }  // namespace tensegrity::fw::comms

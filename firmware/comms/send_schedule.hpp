@@ -32,7 +32,7 @@ class SendSchedule {
   bool unsynced_report_due(std::int64_t now_ns);
 
   std::uint32_t sync_requests() const { return sync_requests_; }  // the last request's sequence number
-  std::int64_t next_ns() const;  // the earliest of telemetry, heartbeat and sync
+  std::int64_t next_ns() const;                                   // the earliest of telemetry, heartbeat and sync
 
  private:
   std::int64_t telemetry_period_ns_;

@@ -47,11 +47,12 @@ void SharedTimeSync::report_if_unsynced(std::uint32_t requests_sent) const {
     c = client_.counters();
   }
   using ull = unsigned long long;
-  log_("time sync: not synchronized after %u requests; replies accepted %llu, late or replayed %llu, implausible %llu "
-       "(round trip > limit %llu, host hold > limit %llu), conflicting %llu",
-       requests_sent, static_cast<ull>(c.accepted), static_cast<ull>(c.unknown_nonce), static_cast<ull>(c.implausible),
-       static_cast<ull>(c.implausible_round_trip), static_cast<ull>(c.implausible_hold),
-       static_cast<ull>(c.conflicting));
+  log_(
+      "time sync: not synchronized after %u requests; replies accepted %llu, late or replayed %llu, implausible %llu "
+      "(round trip > limit %llu, host hold > limit %llu), conflicting %llu",
+      requests_sent, static_cast<ull>(c.accepted), static_cast<ull>(c.unknown_nonce), static_cast<ull>(c.implausible),
+      static_cast<ull>(c.implausible_round_trip), static_cast<ull>(c.implausible_hold),
+      static_cast<ull>(c.conflicting));
 }
 
 }  // namespace tensegrity::fw::comms

@@ -31,8 +31,8 @@ class TableInbox {
 
   // `store` (may be null) keeps the active table and its identity across reboots;
   // its current() record is the active policy at start.
-  TableInbox(const PolicyExpectations& expect, std::int64_t loop_ack_timeout_ns, app::PolicyStore* store,
-             Answer answer, const NodeLog& log);
+  TableInbox(const PolicyExpectations& expect, std::int64_t loop_ack_timeout_ns, app::PolicyStore* store, Answer answer,
+             const NodeLog& log);
 
   // A table one of the node's participants took: queued, or dropped as a copy of
   // one queued (during a rejoin's overlap both participants may take it).

@@ -13,7 +13,7 @@ namespace {
 constexpr int kEndcap = 2;
 constexpr std::uint32_t kLife = 0x1235;
 constexpr std::int64_t kMaxAgeNs = 5'000'000'000;
-constexpr std::int64_t kNow = 10'000'000'000;  // node clock
+constexpr std::int64_t kNow = 10'000'000'000;            // node clock
 const SyncView kSynced{true, 1'000'000'000, 1'000'000};  // host = node + 1 s
 
 CommandSample command(WireCommandKind kind, std::uint32_t seq) {

@@ -47,8 +47,7 @@ core::EndcapTable table_with(double value) {
 }
 
 PolicyTableMsg upload(std::uint32_t sequence, std::uint32_t version, double value = 0.8, bool force = false) {
-  return make_policy_message(table_with(value), kEndcap, PolicyIdentity{"gait", version, "superball", force},
-                             sequence);
+  return make_policy_message(table_with(value), kEndcap, PolicyIdentity{"gait", version, "superball", force}, sequence);
 }
 
 struct Reply {
@@ -59,7 +58,10 @@ struct Reply {
 
 class TableInboxTest : public ::testing::Test {
  protected:
-  TableInboxTest() { expect_.robot = "superball"; expect_.endcap_id = kEndcap; }
+  TableInboxTest() {
+    expect_.robot = "superball";
+    expect_.endcap_id = kEndcap;
+  }
 
   TableInbox make(app::PolicyStore* store) {
     return TableInbox(
