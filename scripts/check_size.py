@@ -170,10 +170,12 @@ def self_test(jobs):
 
 
 def self_test_classes():
-    """A planted class with 21 methods is flagged, one with 20 (and accessors, deleted
-    members, data members built by calls, a nested class) is not."""
+    """A planted class with 21 methods is flagged, one with 20 (and accessors, deleted and
+    defaulted members, a function pointer, data members built by calls, a nested class)
+    is not."""
     def planted(name, methods):
         lines = ["class %s final : public Base {" % name, " public:", "  %s(const %s&) = delete;" % (name, name),
+                 "  ~%s() override = default;" % name, "  void (*on_done)(int) = nullptr;",
                  "  int size() const { return size_; }", "  void set(int v) noexcept override { size_ = v; }",
                  "  std::function<void(int)> callback = [](int) {};", "  std::array<int, 3> a{1, 2, 3};",
                  "  struct Inner {", "    void inner_one();", "    void inner_two() { x = 1; y = 2; }", "  };"]

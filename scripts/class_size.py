@@ -3,19 +3,20 @@
 (scripts/check_size.py): no class or struct outside tests/ with more than 20.
 
 A method is a member function declared in the class body: constructors, the
-destructor, operators and each overload count; a deleted one (`= delete`) does not,
-nor one defined in the body whose body is a single statement (an accessor or a
-forwarder such as `int size() const { return size_; }`). Nested classes are counted
-on their own. The text is read with comments, literals and preprocessor lines
+destructor, operators and each overload count; a deleted or defaulted one
+(`= delete`, `= default`) does not, nor one defined in the body whose body is a
+single statement (an accessor or a forwarder such as
+`int size() const { return size_; }`). Nested classes are counted on their own. The text is read with comments, literals and preprocessor lines
 blanked (check_size.strip_code); class bodies are found by their braces, member
 declarations by their top-level parentheses. Checked against libclang's view of the
 tree (every class of firmware/, sim/, hil/, ground/, cli/, view/, format/, msgs/):
 the same count for each.
 """
+import os
 import re
 
 MAX_METHODS = 20
-HEAD = re.compile(r"\b(class|struct)\s+(?:alignas\s*\([^)]*\)\s*)?(\w+)\s*(?:final\s*)?(?::[^;{()]*)?\{")
+HEAD = re.compile(r"\b(class|struct)\s+(?:alignas\s*\([^)]*\)\s*)?(?:\w+::)*(\w+)\s*(?:final\s*)?(?::[^;{()]*)?\{")
 ACCESS = re.compile(r"\b(public|private|protected)\s*$")
 NOT_MEMBER = re.compile(r"^(friend|using|typedef|static_assert)\b|^template\s*<.*>\s*(class|struct|using)\b")
 TAIL_NAME = re.compile(r"(~?\w+|operator\s*(\(\)|\[\]|[^\s\w(]+|\s\w[\w\s:*&<>]*))\s*$")
@@ -75,7 +76,7 @@ def _without_template_args(text):
 
 def _is_method(declaration):
     d = " ".join(declaration.split())
-    if not d or NOT_MEMBER.match(d) or re.search(r"=\s*delete$", d):
+    if not d or NOT_MEMBER.match(d) or re.search(r"=\s*(delete|default)$", d):
         return False
     if re.match(r"^(class|struct|union|enum)\b", d) and "(" not in d:
         return False
@@ -84,6 +85,8 @@ def _is_method(declaration):
     if p < 0:
         return False
     before = s[:p]
+    if s[p + 1:].lstrip().startswith(("*", "&")):  # a pointer to a function: a data member
+        return False
     # A data member initialised with a call or a lambda (x = f(...)) is not a method.
     if re.sub(r"operator\s*\S*", "", before).find("=") >= 0 or "{" in before:
         return False
@@ -146,3 +149,79 @@ def classes(stripped):
 
     walk(stripped, 0, "")
     return found
+
+
+def libclang_classes(path, root, build_dir):
+    """classes() as libclang sees them (Debian's python3-clang): [(name, counted, declared)]
+    of the class bodies written in `path`, parsed with the build's include folders."""
+    import json
+
+    import clang.cindex as ci
+    if not ci.Config.loaded:
+        ci.Config.set_library_file("/usr/lib/llvm-14/lib/libclang.so.1")
+    flags = {("-I", root)}  # (flag, value): the build's include folders and defines, once each
+    with open(os.path.join(root, build_dir, "compile_commands.json"), encoding="utf-8") as f:
+        for entry in json.load(f):
+            words = entry.get("arguments") or entry["command"].split()
+            for flag, value in zip(words, words[1:]):
+                if flag in ("-I", "-isystem"):
+                    flags.add((flag, os.path.join(entry["directory"], value)))
+            for w in words:
+                if w.startswith("-I") and len(w) > 2:
+                    flags.add(("-I", os.path.join(entry["directory"], w[2:])))
+                elif w.startswith("-D"):
+                    flags.add((w, ""))
+    args = ["-x", "c++", "-std=c++20"] + [w for pair in sorted(flags) for w in pair if w]
+    methods = {ci.CursorKind.CXX_METHOD, ci.CursorKind.CONSTRUCTOR, ci.CursorKind.DESTRUCTOR,
+               ci.CursorKind.FUNCTION_TEMPLATE, ci.CursorKind.CONVERSION_FUNCTION}
+    kinds = {ci.CursorKind.CLASS_DECL, ci.CursorKind.STRUCT_DECL, ci.CursorKind.CLASS_TEMPLATE}
+    full = os.path.abspath(os.path.join(root, path))
+    found = []
+
+    def walk(cursor, prefix):
+        for c in cursor.get_children():
+            if c.location.file is None or os.path.abspath(c.location.file.name) != full:
+                continue
+            if c.kind in (ci.CursorKind.NAMESPACE, ci.CursorKind.UNEXPOSED_DECL):
+                walk(c, prefix)
+            elif c.kind in kinds and c.is_definition():
+                declared = counted = 0
+                for m in c.get_children():
+                    tokens = [t.spelling for t in m.get_tokens()]
+                    if m.kind not in methods or tokens[-2:] in (["=", "delete"], ["=", "default"]):
+                        continue
+                    declared += 1
+                    body = [b for b in m.get_children() if b.kind == ci.CursorKind.COMPOUND_STMT]
+                    counted += 0 if body and len(list(body[0].get_children())) <= 1 else 1
+                found.append((prefix + c.spelling, counted, declared))
+                walk(c, prefix + c.spelling + "::")
+
+    walk(ci.Index.create().parse(full, args=args).cursor, "")
+    return found
+
+
+if __name__ == "__main__":
+    # scripts/class_size.py [-p build/default] FILE...: this count beside libclang's, and
+    # the classes where they differ (exit 1). Needs python3-clang; slow (every header
+    # the file includes is parsed).
+    import argparse
+    import sys
+
+    import check_size
+    ap = argparse.ArgumentParser()
+    ap.add_argument("-p", dest="build_dir", default="build/default")
+    ap.add_argument("files", nargs="+")
+    a = ap.parse_args()
+    differ = 0
+    for rel in a.files:
+        with open(os.path.join(check_size.ROOT, rel), encoding="utf-8", errors="replace") as f:
+            ours = {name: (counted, declared) for name, counted, declared, _ in classes(check_size.code_lines(f.read()))}
+        for name, counted, declared in libclang_classes(rel, check_size.ROOT, a.build_dir):
+            if ours.pop(name, None) != (counted, declared):
+                differ += 1
+                print(f"{rel}: {name}: libclang {counted} ({declared} declared), text {ours.get(name)}")
+        for name in ours:
+            differ += 1
+            print(f"{rel}: {name}: found in the text only")
+    print(f"class size: {len(a.files)} files, {differ} classes counted differently")
+    sys.exit(1 if differ else 0)
