@@ -182,9 +182,7 @@ def libclang_classes(path, root, build_dir):
         for c in cursor.get_children():
             if c.location.file is None or os.path.abspath(c.location.file.name) != full:
                 continue
-            if c.kind in (ci.CursorKind.NAMESPACE, ci.CursorKind.UNEXPOSED_DECL):
-                walk(c, prefix)
-            elif c.kind in kinds and c.is_definition():
+            if c.kind in kinds and c.is_definition():
                 declared = counted = 0
                 for m in c.get_children():
                     tokens = [t.spelling for t in m.get_tokens()]
@@ -195,6 +193,8 @@ def libclang_classes(path, root, build_dir):
                     counted += 0 if body and len(list(body[0].get_children())) <= 1 else 1
                 found.append((prefix + c.spelling, counted, declared))
                 walk(c, prefix + c.spelling + "::")
+            else:  # namespaces, and function bodies: a class may be local to a function
+                walk(c, prefix)
 
     walk(ci.Index.create().parse(full, args=args).cursor, "")
     return found
