@@ -8,9 +8,10 @@ destructor, operators and each overload count; a deleted or defaulted one
 single statement (an accessor or a forwarder such as
 `int size() const { return size_; }`). Nested classes are counted on their own. The text is read with comments, literals and preprocessor lines
 blanked (check_size.strip_code); class bodies are found by their braces, member
-declarations by their top-level parentheses. Checked against libclang's view of the
-tree (every class of firmware/, sim/, hil/, ground/, cli/, view/, format/, msgs/):
-the same count for each.
+declarations by their top-level parentheses. `class_size.py FILE...` puts this count
+beside libclang's (Debian's python3-clang) and names every class where they differ:
+run on every file outside tests/, fuzz/ and bench/ that declares a class (368 classes
+in 183 files), none differed.
 """
 import os
 import re
