@@ -6,8 +6,9 @@ A method is a member function declared in the class body: constructors, the
 destructor, operators and each overload count; a deleted or defaulted one
 (`= delete`, `= default`) does not, nor one defined in the body whose body is a
 single statement (an accessor or a forwarder such as
-`int size() const { return size_; }`). Nested classes are counted on their own. The text is read with comments, literals and preprocessor lines
-blanked (check_size.strip_code); class bodies are found by their braces, member
+`int size() const { return size_; }`), nor a function pointer. Nested classes are
+counted on their own. The text is read with comments, literals and preprocessor
+lines blanked (check_size.strip_code); class bodies are found by their braces, member
 declarations by their top-level parentheses. `class_size.py FILE...` puts this count
 beside libclang's (Debian's python3-clang) and names every class where they differ:
 run on every file outside tests/, fuzz/ and bench/ that declares a class (368 classes
