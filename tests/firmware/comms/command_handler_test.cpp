@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // CommandHandler's decisions without DDS: samples as the node makes them, the sync
 // estimate and the loop's cycle given by the test.
-#include "firmware/comms/command_handler.hpp"
+#include "firmware/comms/node/command_handler.hpp"
 
 #include <gtest/gtest.h>
 

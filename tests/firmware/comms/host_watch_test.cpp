@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Host loss with fake time: the boot grace, the timeout, the stop asked while lost.
-#include "firmware/comms/host_watch.hpp"
+#include "firmware/comms/node/host_watch.hpp"
 
 #include <gtest/gtest.h>
 

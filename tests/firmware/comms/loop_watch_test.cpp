@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The loop-progress watchdog and the injected link faults, with fake time.
-#include "firmware/comms/loop_watch.hpp"
+#include "firmware/comms/node/loop_watch.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // What the node's reports say, built without a participant.
-#include "firmware/comms/node_messages.hpp"
+#include "firmware/comms/node/node_messages.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // When the end cap makes a new participant, with fake time and host heartbeats.
-#include "firmware/comms/rejoin_watch.hpp"
+#include "firmware/comms/node/rejoin_watch.hpp"
 
 #include <gtest/gtest.h>
 

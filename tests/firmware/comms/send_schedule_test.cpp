@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/send_schedule.hpp"
+#include "firmware/comms/node/send_schedule.hpp"
 
 #include <gtest/gtest.h>
 

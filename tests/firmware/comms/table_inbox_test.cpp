@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // TableInbox's decisions without DDS: samples are made with make_policy_message,
 // the loop is the test taking from the mailbox and echoing in a Telemetry.
-#include "firmware/comms/table_inbox.hpp"
+#include "firmware/comms/node/table_inbox.hpp"
 
 #include <gtest/gtest.h>
 
