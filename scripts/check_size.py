@@ -1,8 +1,11 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
 """The size rule of the project's guide, enforced: outside tests/, no source file (C++
-or Python) over 400 lines and no function over 80 lines, except those listed with a
-reason in scripts/size-exceptions.txt (and docs/design/architecture.md, "Size exceptions").
+or Python) over 400 lines, no function over 80 lines and no C++ class over 20 methods,
+except those listed with a reason in scripts/size-exceptions.txt (and
+docs/design/architecture.md, "Size exceptions").
+
+Classes: methods counted from the source text (scripts/class_size.py says what counts).
 
 Files: a plain line count. Python functions (and methods, nested ones each on their
 own): Python's own parser (`ast`), from the `def` line to the function's last line.
@@ -26,6 +29,7 @@ import subprocess
 import sys
 import tempfile
 
+import class_size
 import source_files
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -88,7 +92,7 @@ def python_problems(files, function_ok, used):
 
 
 def read_exceptions(path):
-    files, functions = {}, {}
+    files, functions, classes = {}, {}, {}
     with open(path, encoding="utf-8") as f:
         for n, line in enumerate(f, 1):
             line = line.strip()
@@ -96,14 +100,17 @@ def read_exceptions(path):
                 continue
             head, sep, reason = line.partition(" -- ")
             words = head.split()
-            if not sep or not reason.strip() or not words or words[0] not in ("file", "function") or \
+            if not sep or not reason.strip() or not words or words[0] not in ("file", "function", "class") or \
                     len(words) != (2 if words[0] == "file" else 3):
-                sys.exit(f"{path}:{n}: expected 'file PATH -- REASON' or 'function PATH NAME -- REASON'")
+                sys.exit(f"{path}:{n}: expected 'file PATH -- REASON', 'function PATH NAME -- REASON' "
+                         "or 'class PATH NAME -- REASON'")
             if words[0] == "file":
                 files[words[1]] = reason
-            else:
+            elif words[0] == "function":
                 functions[(words[1], words[2])] = reason
-    return files, functions
+            else:
+                classes[(words[1], words[2])] = reason
+    return files, functions, classes
 
 
 def strip_code(text):
@@ -140,6 +147,19 @@ def strip_code(text):
             out.append(c)
             i += 1
     return "".join(out)
+
+
+def code_lines(text):
+    """strip_code's text with preprocessor lines blanked too."""
+    return "\n".join("" if line.lstrip().startswith("#") else line for line in strip_code(text).split("\n"))
+
+
+def big_classes(path):
+    """[(line, class name, methods)] of the classes in `path` over class_size.MAX_METHODS."""
+    with open(os.path.join(ROOT, path), encoding="utf-8", errors="replace") as f:
+        text = code_lines(f.read())
+    return [(line, name, counted) for name, counted, _, line in class_size.classes(text)
+            if counted > class_size.MAX_METHODS]
 
 
 def longest_code_block(path):
@@ -219,19 +239,44 @@ def self_test(jobs):
         finally:
             ROOT = saved
     print("size check self-test: an 81-line function is flagged, an 80-line one is not")
+    self_test_classes()
+
+
+def self_test_classes():
+    """A planted class with 21 methods is flagged, one with 20 (and accessors, deleted and
+    defaulted members, a function pointer, data members built by calls, a nested class)
+    is not."""
+    def planted(name, methods):
+        lines = ["class %s final : public Base {" % name, " public:", "  %s(const %s&) = delete;" % (name, name),
+                 "  ~%s() override = default;" % name, "  void (*on_done)(int) = nullptr;",
+                 "  int size() const { return size_; }", "  void set(int v) noexcept override { size_ = v; }",
+                 "  std::function<void(int)> callback = [](int) {};", "  std::array<int, 3> a{1, 2, 3};",
+                 "  struct Inner {", "    void inner_one();", "    void inner_two() { x = 1; y = 2; }", "  };"]
+        lines += ["  void m%d(int x);" % i for i in range(methods - 2)]
+        lines += ["  bool operator==(const %s&) const;" % name,
+                  "  void twice() {", "    size_ = 1;", "    size_ = 2;", "  }", " private:", "  int size_ = 0;", "};"]
+        return "\n".join(lines) + "\n"
+    text = code_lines(planted("Over", class_size.MAX_METHODS + 1) + planted("Within", class_size.MAX_METHODS))
+    counts = {name: counted for name, counted, _, _ in class_size.classes(text)}
+    expected = {"Over": class_size.MAX_METHODS + 1, "Over::Inner": 2, "Within": class_size.MAX_METHODS,
+                "Within::Inner": 2}
+    if counts != expected:
+        sys.exit(f"size check self-test: class methods counted {counts}, expected {expected}")
+    print(f"size check self-test: a class of {class_size.MAX_METHODS + 1} methods is flagged, "
+          f"one of {class_size.MAX_METHODS} is not")
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("-p", dest="build_dir", default="build/default", help="build folder with compile_commands.json")
     ap.add_argument("--all", action="store_true", help="clang-tidy on every file, not only the pre-filter's")
-    ap.add_argument("--self-test", action="store_true", help="first check the check on a planted function")
+    ap.add_argument("--self-test", action="store_true", help="first check the check on a planted function and class")
     ap.add_argument("-j", type=int, default=os.cpu_count() or 2)
     ap.add_argument("--exceptions", default=os.path.join(ROOT, "scripts", "size-exceptions.txt"))
     args = ap.parse_args()
     if args.self_test:
         self_test(args.j)
-    file_ok, function_ok = read_exceptions(args.exceptions)
+    file_ok, function_ok, class_ok = read_exceptions(args.exceptions)
     problems, used = [], set()
     files = sources()
     python = python_sources()
@@ -243,6 +288,11 @@ def main():
                 used.add(("file", path))
             else:
                 problems.append(f"{path}: {count} lines (at most {MAX_FILE_LINES})")
+        for line, name, methods in big_classes(path):
+            if (path, name) in class_ok:
+                used.add(("class", path, name))
+            else:
+                problems.append(f"{path}:{line}: class '{name}' has {methods} methods (at most {class_size.MAX_METHODS})")
     db = os.path.join(ROOT, args.build_dir, "compile_commands.json")
     if not os.path.exists(db):
         sys.exit(f"size check: no {db} (configure the build first)")
@@ -262,7 +312,8 @@ def main():
             problems.append(f"{path}:{line}: function '{name}' over {MAX_FUNCTION_LINES} lines")
     problems += python_problems(python, function_ok, used)
     stale = [f"file {p}" for p in file_ok if ("file", p) not in used] + \
-            [f"function {p} {n}" for (p, n) in function_ok if ("function", p, n) not in used]
+            [f"function {p} {n}" for (p, n) in function_ok if ("function", p, n) not in used] + \
+            [f"class {p} {n}" for (p, n) in class_ok if ("class", p, n) not in used]
     print(f"size check: {len(files)} C++ and {len(python)} Python files counted, {len(candidates)} through clang-tidy, "
           f"{len(used)} listed exceptions in use")
     for s in stale:  # a warning: the branch that fixed it may land before the list is edited

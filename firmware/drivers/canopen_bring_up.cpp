@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// CanopenMaster's start-up sequence, one step per poll() so the control loop
-// keeps its period while the nodes come up.
+#include "firmware/drivers/canopen_bring_up.hpp"
+
 #include <array>
 #include <cstdio>
 
@@ -9,55 +9,60 @@
 
 namespace tensegrity::fw::canopen {
 
-void CanopenMaster::start_bring_up(std::int64_t now_ns) {
-  bring_up_ = BringUp{};
-  request_power(PowerRequest::disabled);
+void CanopenBringUp::start(std::int64_t now_ns) {
+  step_ = BringUpStep::idle;
+  step_started_ns_ = 0;
+  request_sent_ = false;
+  drive_index_ = 0;
+  failure_ = {};
+  m_.request_power(PowerRequest::disabled);
   // Reset communication makes every node announce itself with a boot-up message,
   // also when it was left operational by an earlier run of the firmware.
-  for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::reset_communication, config_.drive_node(i));
-  if (config_.use_load_cell) send_nmt(NmtCommand::reset_communication, config_.load_cell_node_id);
+  for (std::size_t i = 0; i < m_.drive_count_; ++i)
+    m_.send_nmt(NmtCommand::reset_communication, m_.config_.drive_node(i));
+  if (m_.config_.use_load_cell) m_.send_nmt(NmtCommand::reset_communication, m_.config_.load_cell_node_id);
   // The end cap's heartbeat starts now: the drives are told to watch it below, and
   // monitoring on their side starts with the first one they hear after that.
-  if (!producing_heartbeat_) {
-    producing_heartbeat_ = true;
-    next_heartbeat_ns_ = now_ns;
+  if (!m_.producing_heartbeat_) {
+    m_.producing_heartbeat_ = true;
+    m_.next_heartbeat_ns_ = now_ns;
   }
   enter_step(BringUpStep::wait_boot, now_ns);
 }
 
-void CanopenMaster::enter_step(BringUpStep step, std::int64_t now_ns) {
-  bring_up_.step = step;
-  bring_up_.step_started_ns = now_ns;
-  bring_up_.request_sent = false;
-  bring_up_.drive_index = 0;
-  if (step == BringUpStep::done) emit(MasterEventKind::bring_up_done, config_.drive_node_id, now_ns);
+void CanopenBringUp::enter_step(BringUpStep step, std::int64_t now_ns) {
+  step_ = step;
+  step_started_ns_ = now_ns;
+  request_sent_ = false;
+  drive_index_ = 0;
+  if (step == BringUpStep::done) m_.emit(MasterEventKind::bring_up_done, m_.config_.drive_node_id, now_ns);
 }
 
-void CanopenMaster::fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t abort_code) {
+void CanopenBringUp::fail(const char* what, std::int64_t now_ns, std::uint32_t abort_code) {
   // With several drives the text names the one that failed (drive node id).
   char where[48];
-  const BringUpStep step = bring_up_.step;
+  const BringUpStep step = step_;
   const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode ||
                          step == BringUpStep::set_heartbeat_consumer || step == BringUpStep::set_abort_connection ||
                          step == BringUpStep::enable;
   if (step == BringUpStep::set_heartbeat_producer) {  // every node, the load cell last
-    const bool drive = bring_up_.drive_index < drive_count_;
+    const bool drive = drive_index_ < m_.drive_count_;
     std::snprintf(where, sizeof where, "%s (%s %u)", to_string(step), drive ? "drive" : "load cell",
-                  static_cast<unsigned>(drive ? config_.drive_node(bring_up_.drive_index) : config_.load_cell_node_id));
-  } else if (drive_count_ > 1 && per_drive) {
-    std::snprintf(where, sizeof where, "%s (drive %u)", to_string(bring_up_.step),
-                  static_cast<unsigned>(config_.drive_node(bring_up_.drive_index)));
+                  static_cast<unsigned>(drive ? m_.config_.drive_node(drive_index_) : m_.config_.load_cell_node_id));
+  } else if (m_.drive_count_ > 1 && per_drive) {
+    std::snprintf(where, sizeof where, "%s (drive %u)", to_string(step_),
+                  static_cast<unsigned>(m_.config_.drive_node(drive_index_)));
   } else {
-    std::snprintf(where, sizeof where, "%s", to_string(bring_up_.step));
+    std::snprintf(where, sizeof where, "%s", to_string(step_));
   }
   if (abort_code != 0) {
-    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s: SDO abort 0x%08X (%s)", where, what,
+    std::snprintf(failure_.data(), failure_.size(), "%s: %s: SDO abort 0x%08X (%s)", where, what,
                   static_cast<unsigned>(abort_code), sdo_abort::text(abort_code));
   } else {
-    std::snprintf(bring_up_.failure.data(), bring_up_.failure.size(), "%s: %s", where, what);
+    std::snprintf(failure_.data(), failure_.size(), "%s: %s", where, what);
   }
-  bring_up_.step = BringUpStep::failed;
-  emit(MasterEventKind::bring_up_failed, config_.drive_node_id, now_ns);
+  step_ = BringUpStep::failed;
+  m_.emit(MasterEventKind::bring_up_failed, m_.config_.drive_node_id, now_ns);
 }
 
 namespace {
@@ -77,32 +82,33 @@ constexpr std::array<SdoStepSpec, 4> kSdoSteps{{
 }};
 }  // namespace
 
-// One SDO step for drive bring_up_.drive_index: starts the transfer once, then
+// One SDO step for drive drive_index_: starts the transfer once, then
 // waits for its outcome. True when it finished: `next` is the step to go on with
 // (failed: fail_bring_up was called).
-bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
-  BringUp& b = bring_up_;
+bool CanopenBringUp::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
   const SdoStepSpec* spec = nullptr;
   for (const SdoStepSpec& s : kSdoSteps) {
-    if (s.step == b.step) spec = &s;
+    if (s.step == step_) spec = &s;
   }
   if (spec == nullptr) return false;
   // Each drive watches the end cap's heartbeat and stops its motor by itself when
   // the end cap falls silent (dead computer, hung loop).
-  const bool supervised = config_.drive_consumer_heartbeat_ms > 0 && config_.producer_heartbeat_period_ns > 0;
+  const bool supervised = m_.config_.drive_consumer_heartbeat_ms > 0 && m_.config_.producer_heartbeat_period_ns > 0;
   std::uint32_t value = 0;
-  switch (b.step) {
+  switch (step_) {
     case BringUpStep::set_mode: value = kModeCyclicSynchronousPosition; break;
     case BringUpStep::set_heartbeat_consumer:
-      value = consumer_heartbeat_entry(config_.master_node_id, config_.drive_consumer_heartbeat_ms);
+      value = consumer_heartbeat_entry(m_.config_.master_node_id, m_.config_.drive_consumer_heartbeat_ms);
       break;
-    case BringUpStep::set_abort_connection: value = static_cast<std::uint16_t>(config_.drive_abort_connection); break;
+    case BringUpStep::set_abort_connection:
+      value = static_cast<std::uint16_t>(m_.config_.drive_abort_connection);
+      break;
     default: break;
   }
-  SdoClient& sdo = drives_[b.drive_index].sdo;
-  if (!b.request_sent) {
-    b.request_sent = sdo_start(NodeRef{NodeRole::drive, b.drive_index}, spec->upload, spec->address, value,
-                               spec->size_bytes, now_ns);
+  SdoClient& sdo = m_.drives_[drive_index_].sdo;
+  if (!request_sent_) {
+    request_sent_ = m_.sdo_start(CanopenMaster::NodeRef{NodeRole::drive, drive_index_}, spec->upload, spec->address,
+                                 value, spec->size_bytes, now_ns);
     return false;
   }
   if (sdo.transfer().status == SdoStatus::pending) return false;
@@ -110,14 +116,14 @@ bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
   sdo.acknowledge();
   next = BringUpStep::failed;
   if (done.status != SdoStatus::done) {
-    fail_bring_up(spec->what, now_ns, done.abort_code);
+    fail(spec->what, now_ns, done.abort_code);
     return true;
   }
-  switch (b.step) {
+  switch (step_) {
     case BringUpStep::set_mode: next = BringUpStep::check_mode; break;
     case BringUpStep::check_mode:
       if (static_cast<std::int8_t>(done.value & 0xFFU) != kModeCyclicSynchronousPosition) {
-        fail_bring_up("drive does not report mode 8 (cyclic synchronous position)", now_ns);
+        fail("drive does not report mode 8 (cyclic synchronous position)", now_ns);
         return true;
       }
       next = supervised ? BringUpStep::set_heartbeat_consumer : BringUpStep::start_nodes;
@@ -128,68 +134,68 @@ bool CanopenMaster::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
   return true;
 }
 
-// 0x1017 of node bring_up_.drive_index (the load cell after the drives): starts the
+// 0x1017 of node drive_index_ (the load cell after the drives): starts the
 // write once, then waits for its outcome. True when every node is done or bring-up
 // failed. The node's heartbeat follows the new period from its next beat, so the
 // consumer's timeouts hold whatever the device's factory default was.
-bool CanopenMaster::step_producer_sdo(std::int64_t now_ns) {
-  BringUp& b = bring_up_;
-  const std::size_t nodes = drive_count_ + (config_.use_load_cell ? 1 : 0);
-  if (config_.node_heartbeat_period_ms == 0 || b.drive_index >= nodes) {
+bool CanopenBringUp::step_producer_sdo(std::int64_t now_ns) {
+  const std::size_t nodes = m_.drive_count_ + (m_.config_.use_load_cell ? 1 : 0);
+  if (m_.config_.node_heartbeat_period_ms == 0 || drive_index_ >= nodes) {
     enter_step(BringUpStep::set_mode, now_ns);
     return true;
   }
-  const NodeRef node =
-      b.drive_index < drive_count_ ? NodeRef{NodeRole::drive, b.drive_index} : NodeRef{NodeRole::load_cell, 0};
-  SdoClient& sdo = sdo_client(node);
-  if (!b.request_sent) {
-    b.request_sent = sdo_start(node, false, {kOdProducerHeartbeatTime, 0}, config_.node_heartbeat_period_ms, 2, now_ns);
+  const CanopenMaster::NodeRef node = drive_index_ < m_.drive_count_
+                                          ? CanopenMaster::NodeRef{NodeRole::drive, drive_index_}
+                                          : CanopenMaster::NodeRef{NodeRole::load_cell, 0};
+  SdoClient& sdo = m_.sdo_client(node);
+  if (!request_sent_) {
+    request_sent_ =
+        m_.sdo_start(node, false, {kOdProducerHeartbeatTime, 0}, m_.config_.node_heartbeat_period_ms, 2, now_ns);
     return false;
   }
   if (sdo.transfer().status == SdoStatus::pending) return false;
   const SdoTransfer done = sdo.transfer();
   sdo.acknowledge();
   if (done.status != SdoStatus::done) {
-    fail_bring_up("writing 0x1017", now_ns, done.abort_code);
+    fail("writing 0x1017", now_ns, done.abort_code);
     return true;
   }
-  const std::size_t following = b.drive_index + 1;
+  const std::size_t following = drive_index_ + 1;
   enter_step(BringUpStep::set_heartbeat_producer, now_ns);
-  b.drive_index = following;
+  drive_index_ = following;
   return step_producer_sdo(now_ns);
 }
 
-void CanopenMaster::step_bring_up(std::int64_t now_ns) {
-  BringUp& b = bring_up_;
-  if (b.step == BringUpStep::idle || b.step == BringUpStep::done || b.step == BringUpStep::failed) return;
+void CanopenBringUp::poll(std::int64_t now_ns) {
+  if (step_ == BringUpStep::idle || step_ == BringUpStep::done || step_ == BringUpStep::failed) return;
 
   const auto heard_since_step = [&](const HeartbeatMonitor& hb) {
-    return hb.status().alive && hb.status().last_seen_ns >= b.step_started_ns;
+    return hb.status().alive && hb.status().last_seen_ns >= step_started_ns_;
   };
   const auto operational = [](const HeartbeatMonitor& hb) {
     return hb.status().alive && hb.status().state == NmtState::operational;
   };
   // Next drive within the same step, or the next step after the last drive.
   const auto next_drive_or = [&](BringUpStep next) {
-    if (b.drive_index + 1 < drive_count_) {
-      const std::size_t following = b.drive_index + 1;
-      enter_step(b.step, now_ns);
-      b.drive_index = following;
+    if (drive_index_ + 1 < m_.drive_count_) {
+      const std::size_t following = drive_index_ + 1;
+      enter_step(step_, now_ns);
+      drive_index_ = following;
     } else {
       enter_step(next, now_ns);
     }
   };
   const auto all_drives = [&](auto&& predicate) {
-    for (std::size_t i = 0; i < drive_count_; ++i) {
+    for (std::size_t i = 0; i < m_.drive_count_; ++i) {
       if (!predicate(i)) return false;
     }
     return true;
   };
 
-  switch (b.step) {
+  switch (step_) {
     case BringUpStep::wait_boot:
-      if (all_drives([&](std::size_t i) { return heard_since_step(drives_[i].hb); }) &&
-          (!config_.use_load_cell || heard_since_step(load_cell_hb_))) {
+      if (all_drives([&](std::size_t i) { return heard_since_step(m_.drives_[i].hb); }) &&
+          (!m_.config_.use_load_cell || heard_since_step(m_.load_cell_hb_))) {
         enter_step(BringUpStep::set_heartbeat_producer, now_ns);
         step_producer_sdo(now_ns);
         return;
@@ -208,13 +214,13 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
       return;
     }
     case BringUpStep::start_nodes:
-      if (!b.request_sent) {
-        for (std::size_t i = 0; i < drive_count_; ++i) send_nmt(NmtCommand::start, config_.drive_node(i));
-        if (config_.use_load_cell) send_nmt(NmtCommand::start, config_.load_cell_node_id);
-        b.request_sent = true;
-      } else if (all_drives([&](std::size_t i) { return operational(drives_[i].hb); }) &&
-                 (!config_.use_load_cell || operational(load_cell_hb_))) {
-        request_power(PowerRequest::operation_enabled);
+      if (!request_sent_) {
+        for (std::size_t i = 0; i < m_.drive_count_; ++i) m_.send_nmt(NmtCommand::start, m_.config_.drive_node(i));
+        if (m_.config_.use_load_cell) m_.send_nmt(NmtCommand::start, m_.config_.load_cell_node_id);
+        request_sent_ = true;
+      } else if (all_drives([&](std::size_t i) { return operational(m_.drives_[i].hb); }) &&
+                 (!m_.config_.use_load_cell || operational(m_.load_cell_hb_))) {
+        m_.request_power(PowerRequest::operation_enabled);
         enter_step(BringUpStep::enable, now_ns);
         return;
       }
@@ -230,34 +236,33 @@ void CanopenMaster::step_bring_up(std::int64_t now_ns) {
 // True when the enable step ended: every drive operation enabled, one in fault, or
 // the end cap asked for a stop meanwhile (its stop outlasts the bring-up: the nodes
 // are up and the drives stay stopped until it asks for them again).
-bool CanopenMaster::step_enable(std::int64_t now_ns) {
-  BringUp& b = bring_up_;
+bool CanopenBringUp::step_enable(std::int64_t now_ns) {
   bool all_enabled = true;
-  for (std::size_t i = 0; i < drive_count_; ++i) {
-    const Cia402State state = drives_[i].status.state;
+  for (std::size_t i = 0; i < m_.drive_count_; ++i) {
+    const Cia402State state = m_.drives_[i].status.state;
     if (state == Cia402State::fault || state == Cia402State::fault_reaction_active) {
-      request_power(PowerRequest::disabled);
-      b.drive_index = i;
-      fail_bring_up("drive entered fault", now_ns);
+      m_.request_power(PowerRequest::disabled);
+      drive_index_ = i;
+      fail("drive entered fault", now_ns);
       return true;
     }
     all_enabled = all_enabled && state == Cia402State::operation_enabled;
   }
-  const bool done = all_enabled || power_request() != PowerRequest::operation_enabled;
+  const bool done = all_enabled || m_.power_request() != PowerRequest::operation_enabled;
   if (done) enter_step(BringUpStep::done, now_ns);
   return done;
 }
 
-void CanopenMaster::fail_step_after_timeout(std::int64_t now_ns) {
-  BringUp& b = bring_up_;
-  if (now_ns - b.step_started_ns <= config_.bring_up_step_timeout_ns) return;
-  request_power(PowerRequest::disabled);
-  if (b.step == BringUpStep::enable) {  // name the first drive that did not come up
-    while (b.drive_index + 1 < drive_count_ && drives_[b.drive_index].status.state == Cia402State::operation_enabled) {
-      ++b.drive_index;
+void CanopenBringUp::fail_step_after_timeout(std::int64_t now_ns) {
+  if (now_ns - step_started_ns_ <= m_.config_.bring_up_step_timeout_ns) return;
+  m_.request_power(PowerRequest::disabled);
+  if (step_ == BringUpStep::enable) {  // name the first drive that did not come up
+    while (drive_index_ + 1 < m_.drive_count_ &&
+           m_.drives_[drive_index_].status.state == Cia402State::operation_enabled) {
+      ++drive_index_;
     }
   }
-  fail_bring_up(b.step == BringUpStep::wait_boot ? "no heartbeat from a node (timeout)" : "timeout", now_ns);
+  fail(step_ == BringUpStep::wait_boot ? "no heartbeat from a node (timeout)" : "timeout", now_ns);
 }
 
 }  // namespace tensegrity::fw::canopen

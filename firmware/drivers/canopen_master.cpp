@@ -258,7 +258,7 @@ void CanopenMaster::poll(std::int64_t now_ns) {
   for (std::size_t i = 0; i < drive_count_; ++i) poll_sdo(NodeRef{NodeRole::drive, i});
   poll_sdo(NodeRef{NodeRole::load_cell, 0});
   produce_heartbeat(now_ns);
-  step_bring_up(now_ns);
+  bring_up_.poll(now_ns);
 }
 
 // The end cap's heartbeat comes from the control loop's own cycle (poll), so a

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 
+#include "firmware/drivers/canopen_bring_up.hpp"
 #include "firmware/drivers/cia402.hpp"
 #include "firmware/drivers/cia402_power.hpp"
 #include "firmware/drivers/emcy.hpp"
@@ -122,22 +123,6 @@ struct MasterEvent {
   EmcyMessage emcy;  // kind == emcy
 };
 
-enum class BringUpStep : std::uint8_t {
-  idle,
-  wait_boot,               // after NMT reset communication: wait for each node's boot-up/heartbeat
-  set_heartbeat_producer,  // SDO 0x1017 = node_heartbeat_period_ms on each drive, then the load cell
-  set_mode,                // SDO 0x6060 = 8 (cyclic synchronous position)
-  check_mode,              // SDO 0x6061 must read 8
-  set_heartbeat_consumer,  // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
-  set_abort_connection,    // SDO 0x6007 = the abort-connection option (with the consumer only)
-  start_nodes,             // NMT start; wait for heartbeats saying operational
-  enable,                  // CiA 402 power-up to operation enabled (needs write_target each cycle)
-  done,
-  failed,
-};
-
-const char* to_string(BringUpStep step);
-
 class CanopenMaster {
  public:
   static constexpr std::size_t kEventCapacity = 32;
@@ -168,9 +153,9 @@ class CanopenMaster {
 
   // Reset communication, then set CSP on each drive, verify it, start the nodes,
   // enable the drives.
-  void start_bring_up(std::int64_t now_ns);
-  BringUpStep bring_up_step() const { return bring_up_.step; }
-  const char* bring_up_failure() const { return bring_up_.failure.data(); }
+  void start_bring_up(std::int64_t now_ns) { bring_up_.start(now_ns); }
+  BringUpStep bring_up_step() const { return bring_up_.step(); }
+  const char* bring_up_failure() const { return bring_up_.failure(); }
 
   // One expedited transfer per node at a time; false when busy or unknown node.
   // NodeRole::drive is drive 0.
@@ -198,15 +183,7 @@ class CanopenMaster {
   const CanopenMasterConfig& config() const { return config_; }
 
  private:
-  struct BringUp {
-    BringUpStep step = BringUpStep::idle;
-    std::int64_t step_started_ns = 0;
-    bool request_sent = false;
-    // The per-node steps go through the drives in turn (set_heartbeat_producer then
-    // takes the load cell as index drive_count).
-    std::size_t drive_index = 0;
-    std::array<char, 128> failure{};
-  };
+  friend class CanopenBringUp;  // the start-up sequence drives the nodes through the master
   // Everything the master keeps per drive node.
   struct DriveNode {
     DriveNode(std::uint8_t id, const CanopenMasterConfig& c)
@@ -247,13 +224,6 @@ class CanopenMaster {
   void on_sync(const CanFrame& frame, std::int64_t now_ns);
 
   void produce_heartbeat(std::int64_t now_ns);
-  void step_bring_up(std::int64_t now_ns);
-  bool step_enable(std::int64_t now_ns);
-  void fail_step_after_timeout(std::int64_t now_ns);
-  bool step_drive_sdo(std::int64_t now_ns, BringUpStep& next);
-  bool step_producer_sdo(std::int64_t now_ns);
-  void enter_step(BringUpStep step, std::int64_t now_ns);
-  void fail_bring_up(const char* what, std::int64_t now_ns, std::uint32_t detail = 0);
 
   CanBus& bus_;
   CanopenMasterConfig config_;
@@ -267,7 +237,7 @@ class CanopenMaster {
   bool producing_heartbeat_ = false;
   std::int64_t next_heartbeat_ns_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
-  BringUp bring_up_;
+  CanopenBringUp bring_up_{*this};
   EventQueue<MasterEvent, kEventCapacity> events_;
   RxDropCounters drops_;
   std::uint64_t frames_accepted_ = 0;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The end cap's side of a stalled link (firmware/comms/node/node_rejoin.cpp), with a real
+// The end cap's side of a stalled link (firmware/comms/node/rejoin_watch.hpp), with a real
 // end-cap node (comms_test_node, end cap 3) and hosts in this process. A stalled
 // security handshake cannot be made to order, so its symptom is forged: a host whose
 // heartbeat names other end caps but never this one. Such a host makes the end cap

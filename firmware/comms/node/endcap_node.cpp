@@ -1,113 +1,80 @@
 // SPDX-License-Identifier: Apache-2.0
-// EndcapNode: construction, the DDS entities, the node thread and the loop's side
-// of the hand-over. The work itself is in node_tables.cpp, node_commands.cpp,
-// node_status.cpp, node_time_sync.cpp and node_rejoin.cpp.
+// EndcapNode: construction, the node thread and the loop's side of the hand-over.
+// The decisions are the parts' (endcap_node.hpp); the participant and its
+// listeners are in node_listeners.cpp.
 #include "firmware/comms/node/endcap_node.hpp"
 
 #include <algorithm>
 #include <chrono>
-#include <cstdarg>
+#include <cmath>
+#include <exception>
 #include <random>
 
 #include "firmware/comms/node/node_dds.hpp"
+#include "firmware/comms/node/node_messages.hpp"
 #include "core/table.hpp"
-#include "msgs/endcap_writers.hpp"
-#include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
-#include "tensegrity_msgs/msg/CommandPubSubTypes.h"
-#include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
-#include "tensegrity_msgs/msg/PolicyAckPubSubTypes.h"
-#include "tensegrity_msgs/msg/PolicyTablePubSubTypes.h"
-#include "tensegrity_msgs/msg/TelemetryPubSubTypes.h"
-#include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"
+#include "tensegrity_msgs/msg/TimeSync.h"
 
 namespace tensegrity::fw::comms {
 
 namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
-constexpr int kInitialSyncBurst = 8;
-constexpr std::int64_t kInitialSyncSpacingNs = 25'000'000;
-// While unsynchronized the log says why, this often (a start is refused until then).
-constexpr std::int64_t kUnsyncedReportNs = 5'000'000'000;
+
 std::int64_t period_ns(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
+
+// Validated before any part is built from it.
+EndcapNodeConfig checked(EndcapNodeConfig config) {
+  config.expect.endcap_id = config.endcap_id;
+  validate(config);
+  return config;
+}
+
+std::uint64_t random_seed() {
+  std::random_device random;
+  return random() ^ (static_cast<std::uint64_t>(random()) << 32);
+}
+
 }  // namespace
 
 EndcapNode::EndcapNode(const EndcapNodeConfig& config, Clock& clock, app::PolicyStore* store)
-    : config_(config),
+    : config_(checked(config)),
       clock_(clock),
-      store_(store),
-      gate_(config.endcap_id, msgs::kFormatVersion, core::seconds_to_ns(config.command_max_age_s)),
-      start_mapper_(config.start_grid_ns),
-      sync_(std::random_device{}() ^ (static_cast<std::uint64_t>(std::random_device{}()) << 32)) {
-  config_.expect.endcap_id = config_.endcap_id;
-  validate(config_);
-  app::StoredTable stored;
-  if (store_ != nullptr && store_->current(stored)) {
-    active_ = stored.identity;
-    active_table_ = stored.table;
-    have_active_table_ = true;
-  }
-}
+      log_(config_.endcap_id, config_.log),
+      sync_(random_seed(), log_),
+      commands_(config_.endcap_id, msgs::kFormatVersion, core::seconds_to_ns(config_.command_max_age_s),
+                config_.start_grid_ns, std::random_device{}() | 1U, log_),
+      tables_(
+          config_.expect, core::seconds_to_ns(config_.loop_ack_timeout_s), store,
+          [this](const PolicyTableMsg& msg, PolicyReason reason, const std::string& text) {
+            // On both participants during a rejoin's overlap: which one the host
+            // hears is not known, and an uploader takes the first ack of a
+            // sequence and ignores the rest.
+            m::PolicyAck_ ack = policy_ack_message(facts(), msg, reason, text);
+            participants_->current()->policy_ack->write(&ack);
+            if (NodeParticipant* old = participants_->retiring()) old->policy_ack->write(&ack);
+          },
+          log_),
+      host_(config_.host_timeout_s, config_.host_boot_grace_s, config_.host_loss, msgs::kFormatVersion, log_),
+      rejoin_(config_.endcap_id, config_.unheard_rejoin_s, log_),
+      loop_watch_(config_.loop_progress, config_.loop_stall_timeout_s, log_),
+      faults_(config_.link_cut, config_.mute_requests, log_),
+      schedule_(period_ns(config_.telemetry_rate_hz), period_ns(config_.heartbeat_rate_hz),
+                core::seconds_to_ns(config_.time_sync_interval_s)),
+      participants_(std::make_unique<Participants>()) {}
 
 EndcapNode::~EndcapNode() { stop(); }
 
 void EndcapNode::start() {
   if (running_.load()) return;
-  dds_ = make_dds();
+  participants_->adopt(make_participant());
   const std::int64_t now = clock_.now_ns();
-  next_telemetry_ns_ = now;
-  next_heartbeat_ns_ = now;
-  next_sync_ns_ = now;
-  next_unsynced_report_ns_ = now + kUnsyncedReportNs;
-  loop_progress_ns_ = now;
-  participant_since_ns_ = now;
-  started_ns_ = now;
-  rejoin_wait_s_ = config_.unheard_rejoin_s;
+  schedule_.start(now);
+  loop_watch_.start(now);
+  host_.start(now);
+  rejoin_.start(now);
   running_.store(true);
   thread_ = std::thread([this] { run(); });
-}
-
-std::unique_ptr<EndcapNode::Dds> EndcapNode::make_dds() {
-  auto d = std::make_unique<Dds>();
-  const msgs::LinkFaults faults{config_.link_cut, config_.mute_requests != nullptr ? &d->muted : nullptr};
-  d->participant = msgs::create_participant(config_.domain, "endcap" + std::to_string(config_.endcap_id), faults,
-                                            config_.enclave_dir);
-  // Reports go out in this end cap's own partition, the only one its identity may
-  // write in (msgs/endcap_writers.hpp); orders come in the default one.
-  d->publisher = d->participant->create_publisher(msgs::endcap_publisher_qos(config_.endcap_id));
-  d->subscriber = d->participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
-  if (d->publisher == nullptr || d->subscriber == nullptr) throw msgs::DdsError("cannot create publisher/subscriber");
-  d->policy_ack = d->writer(msgs::kPolicyAckTopic, dds::TypeSupport(new m::PolicyAck_PubSubType()));
-  d->command_ack = d->writer(msgs::kCommandAckTopic, dds::TypeSupport(new m::CommandAck_PubSubType()));
-  d->telemetry = d->writer(msgs::kTelemetryTopic, dds::TypeSupport(new m::Telemetry_PubSubType()));
-  d->heartbeat = d->writer(msgs::kEndcapHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()));
-  d->sync_request = d->writer(msgs::kTimeSyncRequestTopic, dds::TypeSupport(new m::TimeSyncRequest_PubSubType()));
-  Dds* raw = d.get();  // the listeners reach their own entities, never through dds_
-  auto listener = [this, raw](std::function<void()> fn, const char* topic) {
-    raw->listeners.push_back(std::make_unique<CallbackListener>(std::move(fn), topic, config_.endcap_id, config_.log));
-    return raw->listeners.back().get();
-  };
-  // Readers last: a callback may fire as soon as a reader exists, and it may use
-  // the writers. The two that work in the receive thread reach their reader
-  // through `raw` under its mutex.
-  dds::DataReader* sync_reply =
-      d->reader(msgs::kTimeSyncReplyTopic, dds::TypeSupport(new m::TimeSyncReply_PubSubType()),
-                listener([this, raw] { on_time_sync_reply(*raw); }, msgs::kTimeSyncReplyTopic.name));
-  const msgs::TopicSpec fresh_commands{msgs::kCommandTopic.name, msgs::kCommandTopic.type, msgs::kProfileFreshCommands,
-                                       msgs::kCommandTopic.writer};
-  dds::DataReader* command = d->reader(fresh_commands, dds::TypeSupport(new m::Command_PubSubType()),
-                                       listener([this, raw] { on_commands(*raw); }, msgs::kCommandTopic.name));
-  {
-    std::lock_guard lock(d->callback_mutex);
-    d->sync_reply = sync_reply;
-    d->command = command;
-  }
-  // These two only wake the node thread, which reads them once this object is dds_.
-  d->policy = d->reader(msgs::kPolicyTableTopic, dds::TypeSupport(new m::PolicyTable_PubSubType()),
-                        listener([this] { wake(); }, msgs::kPolicyTableTopic.name));
-  d->host_heartbeat = d->reader(msgs::kHostHeartbeatTopic, dds::TypeSupport(new m::Heartbeat_PubSubType()),
-                                listener([this] { wake(); }, msgs::kHostHeartbeatTopic.name));
-  return d;
 }
 
 void EndcapNode::stop() noexcept {
@@ -115,51 +82,26 @@ void EndcapNode::stop() noexcept {
     wake();
     if (thread_.joinable()) thread_.join();
   }
-  pair_participants(false);
-  // Entities deleted while dds_ still points at them (reset() would null it first).
-  if (dds_) dds_->close();
-  dds_.reset();
-  retire();
+  participants_->close();
 }
-
-bool EndcapNode::try_take_table(app::HostTable& out) noexcept { return tables_.pop(out); }
-bool EndcapNode::try_take_command(app::HostCommand& out) noexcept { return commands_.pop(out); }
 
 void EndcapNode::publish(const app::Telemetry& telemetry) noexcept {
   // Stamped with the node's clock so the node can map loop time <-> its own time.
   const std::int64_t now = clock_.now_ns();
-  // The listener's copy first: the node acks an upload from telemetry_in_, and a start
-  // sent on that ack must find the table in loop_in_.
-  loop_in_.write(LoopPoint{LoopClockPoint{telemetry.time_ns, now},
-                           LoopReadiness{telemetry.drives_enabled, telemetry.fault, telemetry.has_table}});
+  // The command handler's copy first: the node acks an upload from telemetry_in_,
+  // and a start sent on that ack must find the table there.
+  commands_.note_loop(LoopPoint{LoopClockPoint{telemetry.time_ns, now},
+                                LoopReadiness{telemetry.drives_enabled, telemetry.fault, telemetry.has_table}});
   telemetry_in_.write(StampedTelemetry{telemetry, now});
 }
 
-ActivePolicy EndcapNode::active_policy() const {
-  std::lock_guard lock(mutex_);
-  return active_;
-}
-ClockSample EndcapNode::clock_sample() const {
-  std::lock_guard lock(mutex_);
-  return sync_.estimator().best();
-}
-bool EndcapNode::clock_synced() const {
-  std::lock_guard lock(mutex_);
-  return sync_.estimator().synced();
-}
-TimeSyncCounters EndcapNode::time_sync_counters() const {
-  std::lock_guard lock(mutex_);
-  return sync_.counters();
+app::LinkEvents EndcapNode::link_events() const noexcept {
+  return {host_.losses(), host_.returns(), faults_.cuts(), loop_watch_.stalls(), rejoin_.rejoins()};
 }
 
-void EndcapNode::log(const char* format, ...) const {
-  if (!config_.log) return;
-  char text[400];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(text, sizeof text, format, args);
-  va_end(args);
-  std::fprintf(stderr, "endcap %d: %s\n", config_.endcap_id, text);
+NodeFacts EndcapNode::facts() const {
+  return {config_.endcap_id, tables_.active(),    sync_.view(),      host_.lost(),
+          config_.host_loss, commands_.life_id(), commands_.estops()};
 }
 
 void EndcapNode::wake() {
@@ -174,10 +116,10 @@ void EndcapNode::run() {
   while (running_.load()) {
     const std::int64_t now = clock_.now_ns();
     service(now);
-    std::int64_t next = std::min({next_telemetry_ns_, next_heartbeat_ns_, next_sync_ns_});
-    if (remake_pending_) next = std::min(next, next_remake_ns_);
+    std::int64_t next = schedule_.next_ns();
+    if (rejoin_.pending()) next = std::min(next, rejoin_.next_attempt_ns());
     // The loop takes a table within a cycle or two: look again soon, the ack waits on it.
-    if (in_flight_.active && !in_flight_.answered) next = std::min(next, now + 1'000'000);
+    if (tables_.awaiting_loop()) next = std::min(next, now + 1'000'000);
     const std::int64_t wait_ns = std::max<std::int64_t>(0, next - clock_.now_ns());
     std::unique_lock lock(wake_mutex_);
     wake_cv_.wait_for(lock, std::chrono::nanoseconds(wait_ns), [this] { return woken_ || !running_.load(); });
@@ -186,40 +128,80 @@ void EndcapNode::run() {
 }
 
 void EndcapNode::service(std::int64_t now) {
-  report_link_cut();
-  apply_mute_fault();
+  if (faults_.poll()) participants_->current()->muted.store(true, std::memory_order_relaxed);
   StampedTelemetry t;
   if (telemetry_in_.read(t)) {
     last_telemetry_ = t;
     loop_seen_ = true;
   }
-  handle_host_heartbeats(*dds_, now);
-  if (retiring_ != nullptr) handle_host_heartbeats(*retiring_, now);  // still hears the host
-  handle_tables(now);
-  check_host_loss(now);
-  check_heard(now);  // may make a new participant (node_rejoin.cpp)
-  if (now >= next_telemetry_ns_) {
-    send_telemetry();
-    next_telemetry_ns_ += period_ns(config_.telemetry_rate_hz);
-    if (next_telemetry_ns_ <= now) next_telemetry_ns_ = now + period_ns(config_.telemetry_rate_hz);  // fell behind
+  take_samples(*participants_->current(), now);
+  // During a rejoin's overlap the old participant may be the only one that hears the
+  // host: its heartbeats and tables count as much as the new one's.
+  if (NodeParticipant* old = participants_->retiring()) take_samples(*old, now);
+  tables_.poll(now, loop_seen_ ? &last_telemetry_.telemetry : nullptr);
+  if (host_.poll(now) && rejoin_.host_lost(host_.last_heard_ns(), loop_watch_.stalled())) rejoin();
+  const RejoinWatch::Step step =
+      rejoin_.poll(now, {host_.seen(), host_.lost(), loop_watch_.stalled()}, participants_->retiring() != nullptr);
+  if (step.retire_old) participants_->retire();
+  if (step.rejoin) rejoin();
+  send_reports(now);
+}
+
+void EndcapNode::take_samples(NodeParticipant& p, std::int64_t now) {
+  m::Heartbeat_ hb;
+  dds::SampleInfo info;
+  while (p.host_heartbeat->take_next_sample(&hb, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data || !host_.accepts(hb.format_version())) continue;
+    rejoin_.heard(hb.heard_endcaps(), now, host_.fresh(), &p == participants_->current());
+    host_.heard(now);
   }
-  if (now >= next_heartbeat_ns_) {
-    send_heartbeat(now);
-    next_heartbeat_ns_ = std::max(next_heartbeat_ns_ + period_ns(config_.heartbeat_rate_hz), now);
+  PolicyTableMsg msg;
+  while (p.policy->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+    if (info.valid_data) tables_.offer(msg);
   }
-  {
-    std::lock_guard lock(mutex_);
-    sync_.settle(clock_.now_ns());
+}
+
+void EndcapNode::send_reports(std::int64_t now) {
+  NodeParticipant& p = *participants_->current();
+  if (schedule_.telemetry_due(now) && loop_seen_) {
+    m::Telemetry_ msg =
+        telemetry_message(facts(), ++telemetry_sequence_, last_telemetry_.telemetry, last_telemetry_.local_ns);
+    p.telemetry->write(&msg);
   }
-  if (now >= next_sync_ns_) {
-    send_time_sync_request();
-    const bool burst = sync_sequence_ < kInitialSyncBurst;
-    next_sync_ns_ = now + (burst ? kInitialSyncSpacingNs : core::seconds_to_ns(config_.time_sync_interval_s));
+  if (schedule_.heartbeat_due(now) && loop_watch_.alive(now)) {
+    m::Heartbeat_ hb = heartbeat_message(facts(), ++heartbeat_sequence_, now, last_telemetry_.telemetry);
+    p.heartbeat->write(&hb);
   }
-  if (now >= next_unsynced_report_ns_) {
-    next_unsynced_report_ns_ = now + kUnsyncedReportNs;
-    report_if_unsynced();
+  sync_.settle(clock_.now_ns());
+  if (schedule_.sync_due(now)) {
+    m::TimeSyncRequest_ req;
+    req.format_version(msgs::kFormatVersion);
+    req.endcap_id(static_cast<std::int16_t>(config_.endcap_id));
+    req.seq(schedule_.sync_requests());
+    const SharedTimeSync::Request r = sync_.request(clock_);
+    req.t1_ns(r.t1_ns);
+    req.nonce(r.nonce);
+    p.sync_request->write(&req);
   }
+  if (schedule_.unsynced_report_due(now)) sync_.report_if_unsynced(schedule_.sync_requests());
+}
+
+// On the node thread, the only one that makes or closes participants. The new one
+// is made before the old one goes (node_dds.hpp: Participants).
+void EndcapNode::rejoin() {
+  std::unique_ptr<NodeParticipant> fresh;
+  try {
+    fresh = make_participant();
+  } catch (const std::exception& e) {
+    rejoin_.failed(clock_.now_ns(), e.what());
+    return;
+  }
+  participants_->adopt(std::move(fresh));
+  // Counted from when it exists: a secured participant takes a second or more to make.
+  const std::int64_t made = clock_.now_ns();
+  rejoin_.made(made);
+  // Send at once on the new participant; a table half way to the loop is acked from it.
+  schedule_.restart(made);
 }
 
 }  // namespace tensegrity::fw::comms

@@ -56,7 +56,7 @@ struct EndcapNodeConfig {
   // Fault injection (HIL): each time *mute_requests grows, the participant of that
   // moment sends nothing more, for good, and still hears: the symptom of a security
   // handshake stalled one way (docs/guide/security.md), which a new participant clears
-  // (node_rejoin.cpp). A counter, so that a signal handler can ask twice. Null: never.
+  // (rejoin_watch.hpp). A counter, so that a signal handler can ask twice. Null: never.
   const std::atomic<std::uint32_t>* mute_requests = nullptr;
   // Watchdog: the control loop's progress counter (bumped by the loop thread every
   // pass, a lockstep wait for SYNC included). When it stands still for

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// The DDS entities of one EndcapNode (internal to firmware/comms/node).
+// The DDS entities of one EndcapNode participant, and the node's participants
+// (internal to firmware/comms).
 #pragma once
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -46,7 +47,7 @@ class CallbackListener final : public dds::DataReaderListener {
   bool log_;
 };
 
-struct EndcapNode::Dds {
+struct NodeParticipant {
   dds::DomainParticipant* participant = nullptr;
   dds::Publisher* publisher = nullptr;
   dds::Subscriber* subscriber = nullptr;
@@ -71,11 +72,11 @@ struct EndcapNode::Dds {
   bool closed = false;             // guarded by callback_mutex
   bool retiring = false;           // replaced by a new participant, still listening; guarded by callback_mutex
   // The other participant during a rejoin's overlap, which a command listener acks on
-  // too (node_commands.cpp); guarded by EndcapNode::receive_mutex_, and cleared under it
+  // too (node_listeners.cpp); guarded by Participants::serial, and cleared under it
   // before either participant closes.
-  Dds* peer = nullptr;
+  NodeParticipant* peer = nullptr;
 
-  ~Dds() { close(); }
+  ~NodeParticipant() { close(); }
   void close() noexcept {
     {
       std::lock_guard lock(callback_mutex);
@@ -90,6 +91,34 @@ struct EndcapNode::Dds {
   dds::DataReader* reader(const msgs::TopicSpec& spec, dds::TypeSupport type, CallbackListener* listener) {
     return msgs::create_reader(*participant, *subscriber, spec, type, listener);
   }
+};
+
+// The participant of the moment and, after a rejoin, the previous one, still
+// listening until a host hears the new one (rejoin_watch.hpp): the stall may be one
+// way only, so the old one can still carry orders in (an emergency stop among them)
+// until the link works both ways on the new one, and it stays for good if a new one
+// cannot be made. The two participants' command listeners take turns (`serial`),
+// each acking on both participants (which one the host hears is not known);
+// telemetry and heartbeats go out on the current one only. Node thread, except
+// `serial`.
+class Participants {
+ public:
+  ~Participants() { close(); }
+  NodeParticipant* current() const { return current_.get(); }
+  NodeParticipant* retiring() const { return retiring_.get(); }
+  // `fresh` becomes the current one, the current one the retiring one (an older
+  // retiring one closes: never more than two).
+  void adopt(std::unique_ptr<NodeParticipant> fresh);
+  void retire() noexcept;  // the retiring one closes
+  void close() noexcept;   // both close
+
+  // Held by a command listener for a whole sample, its acks on both participants included.
+  std::mutex serial;
+
+ private:
+  void pair(bool paired) noexcept;
+  std::unique_ptr<NodeParticipant> current_;
+  std::unique_ptr<NodeParticipant> retiring_;
 };
 
 }  // namespace tensegrity::fw::comms

@@ -55,25 +55,6 @@ TEST(CanopenMaster, NmtStartMakesANodeOperational) {
   EXPECT_EQ(b.drive.nmt_state(), NmtState::pre_operational);
 }
 
-TEST(CanopenMaster, BringUpSetsCspStartsNodesAndEnablesTheDrive) {
-  Bench b;
-  bring_up(b);
-  EXPECT_EQ(b.drive.mode(), kModeCyclicSynchronousPosition);
-  EXPECT_EQ(b.drive.nmt_state(), NmtState::operational);
-  EXPECT_EQ(b.load_cell.nmt_state(), NmtState::operational);
-  EXPECT_EQ(b.drive.state(), Cia402State::operation_enabled);
-  EXPECT_EQ(b.master.drive().state, Cia402State::operation_enabled);
-  EXPECT_EQ(b.master.drive().mode_display, kModeCyclicSynchronousPosition);
-  // The power-up sequence in CiA 402 order, each step confirmed before the next.
-  std::vector<std::uint16_t> distinct;
-  for (const std::uint16_t cw : b.drive.controlwords) {
-    if (distinct.empty() || distinct.back() != cw) distinct.push_back(cw);
-  }
-  EXPECT_THAT(distinct, ::testing::ElementsAre(0x00, 0x06, 0x07, 0x0F));
-  EXPECT_TRUE(has_event(b.take_events(), MasterEventKind::bring_up_done, 3));
-  EXPECT_EQ(b.master.rx_drops().total(), 0U);
-}
-
 TEST(CanopenMaster, TargetHoldsPositionUntilEnabledThenFollowsTheRestLength) {
   Bench b;
   b.power_on();
@@ -316,28 +297,6 @@ TEST(CanopenMaster, SyncConsumerAndProducer) {
   for (const CanFrame& f : b.bus.log) counters.push_back(f.data[0]);
   EXPECT_THAT(counters, ::testing::ElementsAre(1, 2, 3, 1));
   EXPECT_EQ(b.master.sync().sent, 4U);
-}
-
-TEST(CanopenMaster, BringUpFailsClearlyWhenTheDriveIsSilent) {
-  Bench b;
-  b.load_cell.boot(0, b.device_log);  // the load cell is there, the drive is not
-  b.master.start_bring_up(b.clock.now_ns());
-  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::failed; }, 2'100));
-  EXPECT_THAT(b.master.bring_up_failure(), HasSubstr("no heartbeat"));
-  EXPECT_TRUE(has_event(b.take_events(), MasterEventKind::bring_up_failed, 3));
-}
-
-TEST(CanopenMaster, BringUpFailsWithTheAbortTextWhenCspIsRefused) {
-  Bench b;
-  b.power_on();
-  b.master.start_bring_up(b.clock.now_ns());
-  // Its heartbeat time (0x1017) is taken; the mode is what it refuses.
-  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::set_mode; }, 100));
-  b.drive.script.sdo_abort_all = sdo_abort::kValueRange;
-  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::failed; }, 100));
-  EXPECT_THAT(b.master.bring_up_failure(), HasSubstr("0x6060"));
-  EXPECT_THAT(b.master.bring_up_failure(), HasSubstr("invalid value for parameter"));
-  EXPECT_EQ(b.drive.state(), Cia402State::switch_on_disabled);
 }
 
 }  // namespace
