@@ -3,8 +3,8 @@
 
 #include <cstdio>
 
-#include "sim/core_controller.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::cli {
 

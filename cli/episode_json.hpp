@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "sim/controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/controller.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::cli {
 

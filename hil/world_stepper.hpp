@@ -54,7 +54,7 @@
 #include "hil/start_handshake.hpp"
 #include "hil/tick_source.hpp"
 #include "hil/udp_hub.hpp"
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::hil {
 

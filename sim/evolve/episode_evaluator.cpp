@@ -3,7 +3,7 @@
 
 #include <algorithm>
 
-#include "sim/core_controller.hpp"
+#include "sim/model/core_controller.hpp"
 
 namespace tensegrity::sim::evolve {
 

@@ -10,11 +10,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim {
 namespace {
