@@ -26,6 +26,7 @@ struct BenchEvolveArgs {
   std::int64_t episodes = 100;
   int threads = 0;
   double duration_s = 60.0;
+  double dt_s = 0.0;  // 0: what `tensegrity evolve` scores at by default
   bool json = false;
 };
 
@@ -71,8 +72,11 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
   config.episodes = args.episodes;
   config.duration_s = args.duration_s;
   sim::evolve::set_robot(config, robot);
+  config.dt_s = args.dt_s > 0.0 ? args.dt_s : sim::evolve::default_learning_dt_s(robot);
+  sim::evolve::set_default_early_end(config, robot);
+  const double dt_s = config.dt_s > 0.0 ? config.dt_s : robot.time_step_s;
   // The settled start is computed once per process; keep it out of the timing.
-  (void)sim::settled_state(robot, robot.time_step_s);
+  (void)sim::settled_state(robot, dt_s);
 
   const Timed many = time_run(robot, config, threads);
   Timed one;
@@ -84,6 +88,8 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
     nlohmann::json j = {{"benchmark", "evolve"},
                         {"episodes", args.episodes},
                         {"duration_s", args.duration_s},
+                        {"dt_s", dt_s},
+                        {"early_end_bar_m", config.early_end_bar_m},
                         {"threads", threads},
                         {"wall_s", many.wall_s},
                         {"episodes_per_s", many.episodes_per_s},
@@ -101,8 +107,8 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
     }
     std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("bench evolve: %lld episodes of %.0f s (teams of 50, historical), %d threads\n",
-                static_cast<long long>(args.episodes), args.duration_s, threads);
+    std::printf("bench evolve: %lld episodes of %.0f s at dt %.4g s (teams of 50, historical), %d threads\n",
+                static_cast<long long>(args.episodes), args.duration_s, dt_s, threads);
     std::printf("  %.2f episodes/s, %.2f per core, %.1f s wall\n", many.episodes_per_s, per_core, many.wall_s);
     std::printf("  5000 episodes would take %.0f s; target %.0f s, ratio %.2f\n", projected_s, kTarget5000EpisodesWallS,
                 kTarget5000EpisodesWallS / projected_s);
@@ -129,6 +135,9 @@ void add_bench_evolve_command(CLI::App& bench) {
   cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--dt", args->dt_s,
+                  "Time step teams are scored at, seconds (default: as `tensegrity evolve`, the robot's learning step)")
+      ->check(CLI::Range(1e-5, 0.01));
   cmd->add_flag("--json", args->json, "Print one JSON object");
   cmd->callback([args] { run_bench_evolve(*args); });
 }

@@ -50,6 +50,7 @@ struct EvolveArgs {
   std::int64_t anneal_start_episodes = -1;
   double duration_s = 60.0;
   double dt_s = 0.0;
+  double early_end_m = -1.0;  // negative: the robot's learning.early_end
   std::string out;
   std::string log;
   bool json = false;
@@ -126,7 +127,17 @@ sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot
   config.complexity = args.complexity;
   config.period_s = args.period_s;
   config.duration_s = args.duration_s;
-  config.dt_s = args.dt_s;
+  // The robot's own step asked for by name is the robot's own step: the same run, and
+  // the same checkpoint, as one at a robot without a learning step of its own.
+  config.dt_s =
+      args.dt_s > 0.0 ? (args.dt_s == robot.time_step_s ? 0.0 : args.dt_s) : sim::evolve::default_learning_dt_s(robot);
+  sim::evolve::set_default_early_end(config, robot);
+  if (args.early_end_m >= 0.0) {
+    if (args.early_end_m > 0.0 && config.early_end_speed_m_per_s <= 0.0) {
+      throw CommandError(2, "--early-end: the robot has no learning.early_end.max_speed_m_per_s to bound progress by");
+    }
+    config.early_end_bar_m = args.early_end_m;
+  }
   try {
     sim::evolve::validate(config);
   } catch (const sim::evolve::ConfigError& e) {
@@ -355,8 +366,13 @@ void add_evolve_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.01, 3600.0));
   cmd->add_option("--dt", args->dt_s,
-                  "Time step teams are scored at, seconds (default: the robot's; docs/design/performance.md)")
+                  "Time step teams are scored at, seconds (default: the robot's learning.time_step_s, else its "
+                  "time_step_s; docs/design/performance.md)")
       ->check(CLI::Range(1e-5, 0.01));
+  cmd->add_option("--early-end", args->early_end_m,
+                  "End a team's episode once it provably cannot roll this many metres (default: the robot's "
+                  "learning.early_end.bar_m; 0: every episode runs to its end; docs/design/performance.md)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--out", args->out, "Policy file of the best team")->required();
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");

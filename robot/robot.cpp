@@ -165,6 +165,23 @@ void parse_ground_and_start(const Reader& r, Robot& robot) {
                                                                                 : Robot::StartPose::description;
 }
 
+// Optional: without it, teams are learned at the robot's own step.
+void parse_learning(const Reader& r, Robot& robot) {
+  const Reader learning = r.object_or_empty("learning");
+  learning.only({"time_step_s", "early_end"});
+  robot.learning_time_step_s = learning.positive("time_step_s", robot.time_step_s);
+  if (robot.learning_time_step_s > 0.01) {
+    learning.fail("time_step_s", "must be at most 0.01 s (the model is unstable above)");
+  }
+  if (!learning.has("early_end")) return;
+  const Reader early = learning.object("early_end");
+  early.only({"bar_m", "max_speed_m_per_s"});
+  robot.early_end_bar_m = early.positive("bar_m", 0.0, true);
+  robot.early_end_max_speed_m_per_s = early.positive("max_speed_m_per_s", 0.0, true);
+  if (robot.early_end_bar_m > 1000.0) early.fail("bar_m", "must be at most 1000 m");
+  if (robot.early_end_max_speed_m_per_s > 100.0) early.fail("max_speed_m_per_s", "must be at most 100 m/s");
+}
+
 }  // namespace
 
 std::string fnv1a64_hex(const std::string& text) {
@@ -207,10 +224,14 @@ Robot parse_robot(const std::string& json_text, const std::string& source) {
   parse_cable_defaults(r, robot);
   parse_cables(r, strut_of, robot);
   parse_ground_and_start(r, robot);
-  // The hash names the model, not its prose: rewording the description must not
-  // orphan the policies and checkpoints that record the robot they were learned on.
+  parse_learning(r, robot);
+  // The hash names the model, not its prose nor how it is learned: rewording the
+  // description or changing the learning step must not orphan the policies and
+  // checkpoints that record the robot they were learned on (a checkpoint records its
+  // step itself, and a policy is scored at time_step_s whatever step found it).
   json hashed = doc;
   hashed.erase("description");
+  hashed.erase("learning");
   robot.hash = fnv1a64_hex(hashed.dump());
   return robot;
 }

@@ -62,6 +62,16 @@ struct Robot {
   core::MotorLimits motor;
   double gravity_m_per_s2 = 9.81;
   double time_step_s = 0.001;
+  // learning.time_step_s: the step `tensegrity evolve` scores teams at unless --dt is
+  // given; the robot's own step when absent. It is the robot's to measure: a coarser
+  // step is fit for learning only where every gait learned there rolls within 1 % of
+  // its distance at time_step_s (docs/design/performance.md).
+  double learning_time_step_s = 0.001;
+  // learning.early_end: `tensegrity evolve` ends a team's episode once it provably
+  // cannot roll bar_m, bounding the centre's progress by max_speed_m_per_s
+  // (docs/design/performance.md). bar_m 0 (absent): every episode runs to its end.
+  double early_end_bar_m = 0.0;
+  double early_end_max_speed_m_per_s = 0.0;
   // engine: the rigid-body engine under the model (sim/model/engine.hpp), "ode" (default)
   // or "bullet", to tell the model's physics from its engine's.
   enum class PhysicsEngine { ode, bullet };

@@ -8,7 +8,9 @@
 #   scripts/run.sh [--evolve [--seed N]] [--duration S]
 # The robot is the default, the paper's simulated SUPERball (robots/superball-paper.json);
 # --evolve learns with tensegrity evolve's defaults: 40 members per cable population (the
-# author's is 10) and a 0.05 m step annealed to 0.02 m over episodes 2000-5000. With them
+# author's is 10) and a 0.05 m step annealed to 0.02 m over episodes 2000-5000, except
+# that it scores teams at the robot's own 1 ms step with every episode run to its end
+# (--dt 0.001 --early-end 0), as the shipped policy was learned. With them
 # 10 of seeds 1-10 learned a 33-35 m gait in 5000 episodes (docs/reproduction.md, "The cables");
 # seed 1 learns 33.7 m, the shipped policy to the last digit
 # (tests/sim/shipped_policy_test.cpp holds the shipped file to this seed and these settings).
@@ -22,7 +24,7 @@ while [[ $# -gt 0 ]]; do
     --evolve) evolve=1 ;;
     --duration) duration="${2:?run: --duration needs seconds}"; shift ;;
     --seed) seed="${2:?run: --seed needs a number}"; shift ;;
-    -h|--help) sed -n '3,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '3,16p' "$0"; exit 0 ;;
     *) echo "run: unknown argument $1 (try --help)" >&2; exit 2 ;;
   esac
   shift
@@ -40,11 +42,11 @@ mkdir -p out
 policy=policies/superball-paper-t4-n5.json
 if [[ $evolve -eq 1 ]]; then
   policy=out/evolved.json
-  echo "== evolving a policy (t = 4 s, n = 5, historical average, population 40, step 0.05 -> 0.02 m, 5000 episodes, seed $seed)"
+  echo "== evolving a policy (t = 4 s, n = 5, historical average, population 40, step 0.05 -> 0.02 m, 5000 episodes at 1 ms, seed $seed)"
   # The checkpoint is per robot, seed and schedule: --resume must not continue another
   # seed's run, nor one begun on another robot (its robot hash differs: it would be refused).
   "$tensegrity" evolve --robot robots/superball-paper.json --period 4 --complexity 5 --method historical --episodes 5000 \
-    --population 40 --replace 20 --seed "$seed" --checkpoint "out/evolve-checkpoint-paper-p40-anneal-s$seed" --resume \
+    --population 40 --replace 20 --dt 0.001 --early-end 0 --seed "$seed" --checkpoint "out/evolve-checkpoint-paper-p40-anneal-s$seed" --resume \
     --out "$policy" --log out/evolve-curve.csv
 fi
 

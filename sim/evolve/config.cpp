@@ -63,6 +63,10 @@ void validate(const EvolveConfig& c) {
   if (!(c.period_s > 0.0) || !std::isfinite(c.period_s)) fail("period_s must be > 0");
   if (!(c.duration_s > 0.0) || !std::isfinite(c.duration_s)) fail("duration_s must be > 0");
   if (!(c.dt_s >= 0.0 && c.dt_s <= 0.01)) fail("dt_s must be in [0, 0.01] (0: the robot's step)");
+  if (!(c.early_end_bar_m >= 0.0 && c.early_end_bar_m <= 1000.0)) fail("early_end_bar_m must be in [0, 1000]");
+  if (c.early_end_bar_m > 0.0 && !(c.early_end_speed_m_per_s > 0.0 && c.early_end_speed_m_per_s <= 100.0)) {
+    fail("early_end_speed_m_per_s must be in (0, 100] when early_end_bar_m is set");
+  }
 }
 
 double mutation_sigma_m(const EvolveConfig& c, std::int64_t episodes_done) {
@@ -97,6 +101,10 @@ nlohmann::json config_to_json(const EvolveConfig& c) {
                    {"robot_hash", c.robot_hash}};
   // Written only when set, so that a run at the robot's own step writes what it did.
   if (c.dt_s > 0.0) j["dt_s"] = c.dt_s;
+  if (c.early_end_bar_m > 0.0) {
+    j["early_end_bar_m"] = c.early_end_bar_m;
+    j["early_end_speed_m_per_s"] = c.early_end_speed_m_per_s;
+  }
   return j;
 }
 
@@ -123,6 +131,8 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     c.period_s = j.at("period_s").get<double>();
     c.duration_s = j.at("duration_s").get<double>();
     c.dt_s = j.value("dt_s", 0.0);
+    c.early_end_bar_m = j.value("early_end_bar_m", 0.0);
+    c.early_end_speed_m_per_s = j.value("early_end_speed_m_per_s", 0.0);
     c.robot_name = j.at("robot_name").get<std::string>();
     c.robot_hash = j.at("robot_hash").get<std::string>();
     return c;

@@ -89,6 +89,12 @@ struct EvolveConfig {
   double duration_s = 60.0;
   // The time step teams are scored at, s; 0: the robot's own (its time_step_s).
   double dt_s = 0.0;
+  // A team's episode ends once it provably cannot roll early_end_bar_m, its progress
+  // bounded by early_end_speed_m_per_s; it then scores its distance so far scaled to
+  // the whole episode, at most the bar (an approximation: docs/design/performance.md).
+  // 0: every episode runs to its end.
+  double early_end_bar_m = 0.0;
+  double early_end_speed_m_per_s = 0.0;
   std::string robot_name;
   std::string robot_hash;
 };

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/evolve/episode_evaluator.hpp"
 
+#include <algorithm>
+
 #include "sim/model/core_controller.hpp"
 
 namespace tensegrity::sim::evolve {
@@ -19,15 +21,28 @@ Policy team_policy(const Robot& robot, double period_s, int complexity, const Te
 }
 
 TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, double dt_s,
-                         const Team& team) {
+                         const Team& team, const EarlyEnd& early_end) {
   const Policy policy = team_policy(robot, period_s, complexity, team);
   CoreController controller(robot, policy);
   EpisodeOptions options;
   options.duration_s = duration_s;
   options.dt_s = dt_s;
   options.start = StartKind::settled;
+  options.early_end = early_end;
   const EpisodeResult result = run_episode(robot, controller, options);
-  return TeamResult{result.feasible ? result.distance_m : 0.0, result.feasible};
+  if (!result.feasible) return TeamResult{0.0, false};
+  if (result.ended_early) return TeamResult{early_end_score_m(result, duration_s, early_end.bar_m), true};
+  return TeamResult{result.distance_m, true};
+}
+
+double early_end_score_m(const EpisodeResult& result, double duration_s, double bar_m) {
+  if (!(result.sim_time_s > 0.0)) return 0.0;
+  return std::min(bar_m, result.distance_m * duration_s / result.sim_time_s);
+}
+
+void set_default_early_end(EvolveConfig& config, const Robot& robot) {
+  config.early_end_bar_m = robot.early_end_bar_m;
+  config.early_end_speed_m_per_s = robot.early_end_max_speed_m_per_s;
 }
 
 void set_robot(EvolveConfig& config, const Robot& robot) {
@@ -36,6 +51,10 @@ void set_robot(EvolveConfig& config, const Robot& robot) {
   config.max_rest_length_m = robot.motor.max_rest_length_m;
   config.robot_name = robot.name;
   config.robot_hash = robot.hash;
+}
+
+double default_learning_dt_s(const Robot& robot) {
+  return robot.learning_time_step_s == robot.time_step_s ? 0.0 : robot.learning_time_step_s;
 }
 
 TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config) {
@@ -49,8 +68,9 @@ TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& confi
   const int complexity = config.complexity;
   const double duration_s = config.duration_s;
   const double dt_s = config.dt_s;
-  return [shared, period_s, complexity, duration_s, dt_s](const Team& team) {
-    return evaluate_team(*shared, period_s, complexity, duration_s, dt_s, team);
+  const EarlyEnd early_end{config.early_end_bar_m, config.early_end_speed_m_per_s};
+  return [shared, period_s, complexity, duration_s, dt_s, early_end](const Team& team) {
+    return evaluate_team(*shared, period_s, complexity, duration_s, dt_s, team, early_end);
   };
 }
 

@@ -21,10 +21,23 @@ Policy team_policy(const Robot& robot, double period_s, int complexity, const Te
 // and hash (checkpoints and MPI ranks compare them).
 void set_robot(EvolveConfig& config, const Robot& robot);
 
+// The step a run on `robot` scores teams at when no other is asked for, as
+// EvolveConfig::dt_s: the robot's learning step, or 0 when that is its own step (so
+// that such a run and its checkpoints are what they were before the field existed).
+double default_learning_dt_s(const Robot& robot);
+
+// The robot's early end (learning.early_end) as the config's.
+void set_default_early_end(EvolveConfig& config, const Robot& robot);
+
 // One episode of `duration_s` from the settled start. Thread-safe.
-// dt_s 0: the robot's own step.
+// dt_s 0: the robot's own step. An episode ended by `early_end` scores
+// early_end_score_m.
 TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, double dt_s,
-                         const Team& team);
+                         const Team& team, const EarlyEnd& early_end = {});
+
+// What an episode ended early scores: its distance so far scaled to the whole
+// duration (a steady gait's own score), at most the bar it provably cannot reach.
+double early_end_score_m(const EpisodeResult& result, double duration_s, double bar_m);
 
 // evaluate_team with the config's episode settings, as a thread-safe function that
 // keeps its own copy of the robot. Throws ConfigError when the robot does not fit the

@@ -17,8 +17,9 @@ Robot parse_checked(const EpisodeSetup& setup) {
 }  // namespace
 
 EpisodeSetup episode_setup(const std::string& robot_json, const EvolveConfig& config) {
-  EpisodeSetup setup{robot_json,        config.robot_hash, config.cables, config.period_s,
-                     config.complexity, config.duration_s, config.dt_s};
+  EpisodeSetup setup{robot_json,      config.robot_hash,      config.cables,
+                     config.period_s, config.complexity,      config.duration_s,
+                     config.dt_s,     config.early_end_bar_m, config.early_end_speed_m_per_s};
   // Fail on rank 0, before anything is sent, when the text is not the config's robot.
   (void)parse_checked(setup);
   return setup;
@@ -33,6 +34,8 @@ wire::Setup to_wire(const EpisodeSetup& setup) {
   w.u32(static_cast<std::uint32_t>(setup.complexity));
   w.f64(setup.duration_s);
   w.f64(setup.dt_s);
+  w.f64(setup.early_end_bar_m);
+  w.f64(setup.early_end_speed_m_per_s);
   const wire::Bytes bytes = w.take();
   return wire::Setup{wire::kProtocol, kEpisodeSetupKind, std::string(bytes.begin(), bytes.end())};
 }
@@ -51,6 +54,8 @@ EpisodeSetup episode_setup_from_wire(const wire::Setup& setup) {
     s.complexity = static_cast<int>(r.u32());
     s.duration_s = r.f64();
     s.dt_s = r.f64();
+    s.early_end_bar_m = r.f64();
+    s.early_end_speed_m_per_s = r.f64();
     r.finish();
     return s;
   } catch (const wire::WireError& e) {
@@ -67,6 +72,8 @@ TeamFunction episode_team_function(const EpisodeSetup& setup) {
   config.complexity = setup.complexity;
   config.duration_s = setup.duration_s;
   config.dt_s = setup.dt_s;
+  config.early_end_bar_m = setup.early_end_bar_m;
+  config.early_end_speed_m_per_s = setup.early_end_speed_m_per_s;
   validate(config);
   return episode_team_function(robot, config);
 }

@@ -14,7 +14,7 @@
 namespace tensegrity::sim::evolve {
 
 // The `kind` of a setup for physics episodes.
-inline constexpr const char* kEpisodeSetupKind = "tensegrity-episode/2";
+inline constexpr const char* kEpisodeSetupKind = "tensegrity-episode/3";
 
 struct EpisodeSetup {
   std::string robot_json;  // the description's text as read (the hash covers its content)
@@ -23,7 +23,9 @@ struct EpisodeSetup {
   double period_s = 0.0;
   int complexity = 0;
   double duration_s = 0.0;
-  double dt_s = 0.0;  // 0: the robot's own step
+  double dt_s = 0.0;             // 0: the robot's own step
+  double early_end_bar_m = 0.0;  // 0: no early end
+  double early_end_speed_m_per_s = 0.0;
 };
 
 // Throws ConfigError when `robot_json` is not the robot the config was made for.

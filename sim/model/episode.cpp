@@ -164,6 +164,14 @@ void mark_infeasible(EpisodeResult& result, std::string why, double time_s) {
   result.infeasible_time_s = time_s;
 }
 
+// Whether the episode can end at `now_s` of `end_s` under `rule`: from here no
+// path of the centre at the rule's speed reaches the bar (|d(T)| <= |d(t)| + v (T - t)).
+bool cannot_reach_bar(const EarlyEnd& rule, const Model& model, const Eigen::Vector2d& start, double now_s,
+                      double end_s) {
+  const double reachable_m = (horizontal(model.centre_m()) - start).norm() + rule.max_speed_m_per_s * (end_s - now_s);
+  return reachable_m < rule.bar_m;
+}
+
 }  // namespace
 
 EpisodeResult run_episode(const Robot& robot, Controller& controller, const EpisodeOptions& options) {
@@ -179,6 +187,9 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
   const auto steps = static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   const double hard_limit = robot.motor.hard_limit_tension_n;
   const int every = std::max(1, options.telemetry_every);
+  // Every whole second of simulated time (at least every step).
+  const std::int64_t check_every =
+      options.early_end.bar_m > 0.0 ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
 
   EpisodeResult result;
   Tally tally(robot, model);
@@ -211,6 +222,11 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
       why << "cable " << tally.worst_cable() << " tension " << step_max << " N above the hard limit " << hard_limit
           << " N";
       mark_infeasible(result, why.str(), now);
+      break;
+    }
+    if (check_every > 0 && (k + 1) % check_every == 0 && k + 1 < steps &&
+        cannot_reach_bar(options.early_end, model, start, now, static_cast<double>(steps) * dt)) {
+      result.ended_early = true;
       break;
     }
   }

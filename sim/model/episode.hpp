@@ -18,6 +18,14 @@ enum class StartKind {
   drop,     // the description's pose, lowest end cap clearance_m above the ground
 };
 
+// Ends an episode once its distance provably cannot reach bar_m: even moving at
+// max_speed_m_per_s for the rest of it, the centre would end nearer its start than
+// bar_m. Checked every whole second of simulated time. bar_m 0: never.
+struct EarlyEnd {
+  double bar_m = 0.0;
+  double max_speed_m_per_s = 0.0;
+};
+
 struct EpisodeOptions {
   double duration_s = 60.0;
   double dt_s = 0.0;  // 0: the robot's time step
@@ -25,6 +33,7 @@ struct EpisodeOptions {
   const ModelState* start_state = nullptr;  // a given pose; overrides `start`
   TelemetrySink* telemetry = nullptr;
   int telemetry_every = 1;  // record every N-th step
+  EarlyEnd early_end;
 };
 
 struct EpisodeResult {
@@ -48,6 +57,8 @@ struct EpisodeResult {
   double min_strut_gap_m = 0.0;
   double strut_overlap_s = 0.0;
   double sim_time_s = 0.0;
+  // Ended by options.early_end at sim_time_s; distance_m is the distance then.
+  bool ended_early = false;
   double wall_time_s = 0.0;
   std::int64_t steps = 0;
   double real_time_factor() const { return wall_time_s > 0.0 ? sim_time_s / wall_time_s : 0.0; }

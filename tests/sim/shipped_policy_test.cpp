@@ -68,7 +68,8 @@ TEST(ShippedPolicies, TheMainJobsGaitIsTheDefaultRobotsAndRollsAsTheIssueAsks) {
   EXPECT_LE(policy.provenance.episodes, 5000);
   EXPECT_GE(policy.provenance.score_m, 32.0);
   // It is what `scripts/run.sh --evolve` learns (its seed, sizes and step schedule: the
-  // CLI's defaults), so a user's own run reproduces it; change them together.
+  // CLI's defaults; scored at the robot's own step, every episode to its end), so a
+  // user's own run reproduces it; change them together.
   EXPECT_EQ(policy.provenance.seed, 1U);
   EXPECT_EQ(policy.provenance.population, 40);
   EXPECT_EQ(policy.provenance.replace, 20);

@@ -23,9 +23,10 @@ def pin_robot(a):
 
 
 # What decides a run's result besides its id: `tensegrity evolve`'s defaults for these
-# changed between versions (sizes, then the step schedule).
+# changed between versions (sizes, then the step schedule, then the robot's learning step
+# and early end).
 SETTINGS = ("population", "replace", "teams", "mutation", "sigma_m", "sigma_final_m", "anneal_start_episodes",
-            "anneal_episodes")
+            "anneal_episodes", "dt_s", "early_end_bar_m", "early_end_speed_m_per_s")
 
 
 def pin_settings(a):

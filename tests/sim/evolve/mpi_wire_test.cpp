@@ -118,6 +118,8 @@ TEST(EpisodeSetup, RoundTripsAndScoresLikeRankZero) {
   const Robot robot = parse_robot(text);
   EvolveConfig config = physics_config(robot);
   config.dt_s = 0.002;
+  config.early_end_bar_m = 0.3;
+  config.early_end_speed_m_per_s = 0.25;
   const EpisodeSetup sent = episode_setup(text, config);
   const EpisodeSetup got = episode_setup_from_wire(wire::decode_setup(wire::encode(to_wire(sent))));
   EXPECT_EQ(got.robot_json, text);
@@ -127,6 +129,8 @@ TEST(EpisodeSetup, RoundTripsAndScoresLikeRankZero) {
   EXPECT_EQ(got.complexity, config.complexity);
   EXPECT_EQ(bits(got.duration_s), bits(config.duration_s));
   EXPECT_EQ(bits(got.dt_s), bits(config.dt_s));
+  EXPECT_EQ(bits(got.early_end_bar_m), bits(config.early_end_bar_m));
+  EXPECT_EQ(bits(got.early_end_speed_m_per_s), bits(config.early_end_speed_m_per_s));
 
   Team team;
   for (int c = 0; c < config.cables; ++c) team.rest_lengths_m.push_back({0.8, 0.95 - 0.005 * c, 0.7});
