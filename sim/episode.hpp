@@ -5,10 +5,12 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sim/controller.hpp"
 #include "sim/model.hpp"
 #include "sim/robot.hpp"
+#include "sim/start_frame.hpp"
 #include "sim/telemetry.hpp"
 
 namespace tensegrity::sim {
@@ -30,6 +32,10 @@ struct EpisodeOptions {
 struct EpisodeResult {
   double distance_m = 0.0;  // horizontal, centre of the end caps, final minus initial
   Eigen::Vector2d displacement_m = Eigen::Vector2d::Zero();
+  // The same displacement in the start frame (sim/start_frame.hpp) and its heading;
+  // zero and no heading when the episode was infeasible.
+  Travel travel;
+  std::vector<int> start_face;  // the end caps of the hull face the robot started on
   bool feasible = true;
   std::string infeasible_reason;
   double infeasible_time_s = 0.0;
