@@ -223,6 +223,7 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
     mark_infeasible(result, "state not finite (the model diverged)", static_cast<double>(done) * dt);
   }
   if (options.telemetry != nullptr) options.telemetry->end();
+  if (options.end_state != nullptr) *options.end_state = model.save();
 
   result.steps = done;
   result.sim_time_s = static_cast<double>(done) * dt;
