@@ -82,8 +82,8 @@ void run_symmetries(const GaitsArgs& args) {
                     {"heading_map", isometry_json(a)}});
   }
   if (args.json) {
-    const nlohmann::json j = {{"robot", robot.name},     {"robot_hash", robot.hash},
-                              {"order", group.size()},   {"start_face", faces[start].nodes},
+    const nlohmann::json j = {{"robot", robot.name},        {"robot_hash", robot.hash},
+                              {"order", group.size()},      {"start_face", faces[start].nodes},
                               {"hull_faces", faces.size()}, {"symmetries", list}};
     std::printf("%s\n", j.dump(2).c_str());
     return;
@@ -158,7 +158,8 @@ void run_set(const GaitsArgs& args) {
     // settled start's own face the gait is played and measured instead.
     sim::EpisodeResult r = base;
     if (image == start && !s.matrix.isIdentity(1e-9)) r = play(robot, g.policy, args.duration_s);
-    const Eigen::Vector2d d = image == start ? r.travel.start_m : Eigen::Vector2d(sim::heading_map(s, faces, start) * base.travel.start_m);
+    const Eigen::Vector2d d =
+        image == start ? r.travel.start_m : Eigen::Vector2d(sim::heading_map(s, faces, start) * base.travel.start_m);
     g.basis = image == start ? "measured" : "symmetry";
     g.heading_deg = sim::wrap_deg(deg(std::atan2(d.y(), d.x())));
     g.speed_m_per_min = (r.feasible ? d.norm() : 0.0) * 60.0 / args.duration_s;
@@ -177,7 +178,8 @@ void add_common(CLI::App* cmd, GaitsArgs& args, bool policy_required) {
   cmd->add_option("--robot", args.robot,
                   "Robot description (default: the one the policy names, else robots/superball-paper.json)")
       ->check(CLI::ExistingFile);
-  auto* policy = cmd->add_option("--policy", args.policy, "Policy file (tensegrity-policy/1)")->check(CLI::ExistingFile);
+  auto* policy =
+      cmd->add_option("--policy", args.policy, "Policy file (tensegrity-policy/1)")->check(CLI::ExistingFile);
   if (policy_required) policy->required();
 }
 
@@ -195,7 +197,8 @@ void add_gaits_command(CLI::App& app) {
 
   CLI::App* tr = gaits->add_subcommand("transform", "Write a policy's image under one of the robot's symmetries");
   add_common(tr, *args, true);
-  tr->add_option("--symmetry", args->symmetry, "The symmetry, by name as `gaits symmetries` lists it, e.g. \"(-x, y, z)\"")
+  tr->add_option("--symmetry", args->symmetry,
+                 "The symmetry, by name as `gaits symmetries` lists it, e.g. \"(-x, y, z)\"")
       ->required();
   tr->add_option("--out", args->out, "Policy file to write")->required();
   tr->add_option("--duration", args->duration_s, "Episode that measures the image's heading, seconds")

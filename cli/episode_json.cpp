@@ -42,10 +42,11 @@ nlohmann::json episode_json(const sim::EpisodeResult& r) {
 
 void print_heading(const sim::Travel& t, const std::vector<int>& face) {
   std::string on = "no hull face";
-  if (face.size() == 3) on = "face " + std::to_string(face[0]) + "-" + std::to_string(face[1]) + "-" + std::to_string(face[2]);
+  if (face.size() == 3)
+    on = "face " + std::to_string(face[0]) + "-" + std::to_string(face[1]) + "-" + std::to_string(face[2]);
   if (t.heading_deg) {
-    std::printf("  heading        %+8.1f deg in the start frame (dx %.3f, dy %.3f; %s, yaw %+.1f deg)\n", *t.heading_deg,
-                t.start_m.x(), t.start_m.y(), on.c_str(), t.yaw_deg);
+    std::printf("  heading        %+8.1f deg in the start frame (dx %.3f, dy %.3f; %s, yaw %+.1f deg)\n",
+                *t.heading_deg, t.start_m.x(), t.start_m.y(), on.c_str(), t.yaw_deg);
   } else {
     std::printf("  heading        none (the robot did not move; %s, yaw %+.1f deg)\n", on.c_str(), t.yaw_deg);
   }

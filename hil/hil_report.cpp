@@ -98,10 +98,11 @@ std::string summary_text(const HilResult& r) {
                 r.stats.run_wall_s > 0 ? r.stats.sim_time_s() / r.stats.run_wall_s : 0.0);
   s << line;
   if (r.travel.heading_deg) {
-    std::snprintf(line, sizeof line,
-                  "heading %+.1f deg in the start frame (dx %.3f, dy %.3f m; world dx %.3f, dy %.3f m, yaw %+.1f deg)\n",
-                  *r.travel.heading_deg, r.travel.start_m.x(), r.travel.start_m.y(), r.travel.world_m.x(),
-                  r.travel.world_m.y(), r.travel.yaw_deg);
+    std::snprintf(
+        line, sizeof line,
+        "heading %+.1f deg in the start frame (dx %.3f, dy %.3f m; world dx %.3f, dy %.3f m, yaw %+.1f deg)\n",
+        *r.travel.heading_deg, r.travel.start_m.x(), r.travel.start_m.y(), r.travel.world_m.x(), r.travel.world_m.y(),
+        r.travel.yaw_deg);
     s << line;
   }
   if (!r.ok) s << "reason: " << r.error << "\n";

@@ -70,7 +70,8 @@ GaitSet parse_gait_set(const std::string& json_text, const Robot& robot, const s
   }
   GaitSet set;
   set.robot = r.string("robot");
-  if (set.robot != robot.name) r.fail("robot", "the set is for robot \"" + set.robot + "\", not \"" + robot.name + "\"");
+  if (set.robot != robot.name)
+    r.fail("robot", "the set is for robot \"" + set.robot + "\", not \"" + robot.name + "\"");
   if (r.has("robot_hash")) set.robot_hash = r.string("robot_hash");
   if (r.has("source")) set.source = r.string("source");
   set.duration_s = r.positive("duration_s", 0.0, true);

@@ -24,20 +24,20 @@ class GaitSetError : public std::runtime_error {
 inline constexpr const char* kGaitSetFormat = "tensegrity-gait-set/1";
 
 struct Gait {
-  std::string name;                  // unique in the set
-  std::string symmetry;              // the symmetry that made it from the set's source; empty: none
-  std::array<int, 3> face{};         // the end caps of the hull face it starts from, increasing
-  double heading_deg = 0.0;          // in that face's start frame, (-180, 180]
-  double speed_m_per_min = 0.0;      // straight-line distance per minute of rolling
-  std::string basis = "symmetry";    // "measured" (this gait was played) or "symmetry" (carried from the source)
+  std::string name;                // unique in the set
+  std::string symmetry;            // the symmetry that made it from the set's source; empty: none
+  std::array<int, 3> face{};       // the end caps of the hull face it starts from, increasing
+  double heading_deg = 0.0;        // in that face's start frame, (-180, 180]
+  double speed_m_per_min = 0.0;    // straight-line distance per minute of rolling
+  std::string basis = "symmetry";  // "measured" (this gait was played) or "symmetry" (carried from the source)
   Policy policy;
 };
 
 struct GaitSet {
   std::string robot;
-  std::string robot_hash;  // of the robot the figures were measured on; empty: not recorded
-  std::string source;      // the policy file the set was made from; empty: not recorded
-  double duration_s = 0.0; // the episode length the figures come from
+  std::string robot_hash;   // of the robot the figures were measured on; empty: not recorded
+  std::string source;       // the policy file the set was made from; empty: not recorded
+  double duration_s = 0.0;  // the episode length the figures come from
   std::vector<Gait> gaits;
 };
 

@@ -66,7 +66,8 @@ Eigen::Matrix3d fit_rotation(std::span<const Eigen::Vector3d> from, std::span<co
   return svd.matrixV() * d * svd.matrixU().transpose();
 }
 
-StartFrame start_frame(const Robot& robot, const std::vector<HullFace>& faces, std::span<const Eigen::Vector3d> nodes_m) {
+StartFrame start_frame(const Robot& robot, const std::vector<HullFace>& faces,
+                       std::span<const Eigen::Vector3d> nodes_m) {
   StartFrame f;
   const Eigen::Vector3d c = centroid(nodes_m);
   f.origin_m = {c.x(), c.y()};

@@ -19,7 +19,7 @@ namespace tensegrity::sim {
 
 // A triangle of the convex hull of the description's end caps.
 struct HullFace {
-  std::array<int, 3> nodes{};  // increasing
+  std::array<int, 3> nodes{};                        // increasing
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // outward, unit, description frame
   bool closed = false;                               // all three edges are cables
 };
@@ -45,7 +45,8 @@ struct StartFrame {
 
 // The start frame of the pose `nodes_m` (world, one per end cap): the hull face
 // pointing most nearly down is the one the robot stands on.
-StartFrame start_frame(const Robot& robot, const std::vector<HullFace>& faces, std::span<const Eigen::Vector3d> nodes_m);
+StartFrame start_frame(const Robot& robot, const std::vector<HullFace>& faces,
+                       std::span<const Eigen::Vector3d> nodes_m);
 
 struct Travel {
   Eigen::Vector2d world_m = Eigen::Vector2d::Zero();  // end centre minus start centre, world frame

@@ -39,8 +39,10 @@ std::string axis_name(const Eigen::Matrix3d& m) {
   for (int r = 0; r < 3; ++r) {
     int col = -1;
     for (int c = 0; c < 3; ++c) {
-      if (std::abs(std::abs(m(r, c)) - 1.0) < 1e-6) col = c;
-      else if (std::abs(m(r, c)) > 1e-6) return "";
+      if (std::abs(std::abs(m(r, c)) - 1.0) < 1e-6)
+        col = c;
+      else if (std::abs(m(r, c)) > 1e-6)
+        return "";
     }
     if (col < 0) return "";
     out += std::string(r ? ", " : "") + (m(r, col) < 0 ? "-" : "") + axes[col];
@@ -96,7 +98,8 @@ class Matcher {
       const auto it = cables_.find(ordered(out.node_map[from.node_a], out.node_map[from.node_b]));
       if (it == cables_.end()) return false;
       const CableSpec& to = robot_.cables[it->second];
-      if (to.stiffness_n_per_m != from.stiffness_n_per_m || to.damping_n_s_per_m != from.damping_n_s_per_m) return false;
+      if (to.stiffness_n_per_m != from.stiffness_n_per_m || to.damping_n_s_per_m != from.damping_n_s_per_m)
+        return false;
       out.cable_map[c] = it->second;
       out.owners_follow = out.owners_follow && to.owner == out.node_map[from.owner];
     }
@@ -203,8 +206,8 @@ Eigen::Matrix2d heading_map(const Symmetry& symmetry, const std::vector<HullFace
   const int image = face_image(symmetry, faces, face);
   // The image face's canonical pose, relabelled, is this map applied to the source
   // face's canonical pose; it keeps the vertical, so its horizontal part is all.
-  const Eigen::Matrix3d a = face_down_turn(faces.at(image).normal) * symmetry.matrix *
-                            face_down_turn(faces.at(face).normal).transpose();
+  const Eigen::Matrix3d a =
+      face_down_turn(faces.at(image).normal) * symmetry.matrix * face_down_turn(faces.at(face).normal).transpose();
   return a.topLeftCorner<2, 2>();
 }
 

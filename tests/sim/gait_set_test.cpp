@@ -27,7 +27,12 @@ class GaitSetFile : public ::testing::Test {
     const auto group = symmetry_group(robot);
     GaitSet set{robot.name, robot.hash, "policies/superball-paper-t4-n5.json", 60.0, {}};
     set.gaits.push_back({"(x, y, z)", "(x, y, z)", {0, 4, 10}, -124.0, 33.7, "measured", policy});
-    set.gaits.push_back({"(-x, y, z)", "(-x, y, z)", {2, 4, 11}, 33.4, 33.7, "symmetry",
+    set.gaits.push_back({"(-x, y, z)",
+                         "(-x, y, z)",
+                         {2, 4, 11},
+                         33.4,
+                         33.7,
+                         "symmetry",
                          image_of(policy, find_symmetry(group, "(-x, y, z)"), robot)});
     return json::parse(gait_set_to_json(set));
   }
@@ -71,9 +76,18 @@ TEST_F(GaitSetFile, EachBadFieldIsNamed) {
       {[](json& d) { d["gaits"] = json::array(); }, "set.json: gaits: must hold at least one gait"},
       {[](json& d) { d["colour"] = "red"; }, "set.json: colour: unknown field"},
       {[](json& d) { d["gaits"][1]["name"] = "(x, y, z)"; }, "gaits[1].name: \"(x, y, z)\" appears twice"},
-      {[](json& d) { d["gaits"][0]["face"] = {0, 4}; }, "gaits[0].face: must hold the 3 end caps"},
-      {[](json& d) { d["gaits"][0]["face"] = {0, 4, 12}; }, "gaits[0].face[2]: no such end cap"},
-      {[](json& d) { d["gaits"][0]["face"] = {0, 1, 2}; }, "gaits[0].face: end caps 0, 1, 2 are not a face"},
+      {[](json& d) {
+         d["gaits"][0]["face"] = {0, 4};
+       },
+       "gaits[0].face: must hold the 3 end caps"},
+      {[](json& d) {
+         d["gaits"][0]["face"] = {0, 4, 12};
+       },
+       "gaits[0].face[2]: no such end cap"},
+      {[](json& d) {
+         d["gaits"][0]["face"] = {0, 1, 2};
+       },
+       "gaits[0].face: end caps 0, 1, 2 are not a face"},
       {[](json& d) { d["gaits"][1]["heading_deg"] = -180.0; }, "gaits[1].heading_deg: must be within (-180, 180]"},
       {[](json& d) { d["gaits"][1]["speed_m_per_min"] = -1.0; }, "gaits[1].speed_m_per_min: must be >= 0"},
       {[](json& d) { d["gaits"][1].erase("basis"); }, "gaits[1].basis: missing"},

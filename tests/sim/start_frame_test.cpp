@@ -68,7 +68,8 @@ TEST(StartFrame, EpisodeReportsTheSettledFaceAndHeading) {
   ASSERT_EQ(r.start_face.size(), 3u);
   // The settled start stands on a closed cable triangle.
   bool closed = false;
-  for (const auto& f : faces) closed = closed || (f.closed && std::vector<int>(f.nodes.begin(), f.nodes.end()) == r.start_face);
+  for (const auto& f : faces)
+    closed = closed || (f.closed && std::vector<int>(f.nodes.begin(), f.nodes.end()) == r.start_face);
   EXPECT_TRUE(closed);
   ASSERT_TRUE(r.travel.heading_deg.has_value());
   const double world = std::atan2(r.displacement_m.y(), r.displacement_m.x()) * 180.0 / M_PI;

@@ -21,7 +21,9 @@ namespace {
 namespace fs = std::filesystem;
 
 Robot paper() { return load_robot(default_robot_path()); }
-fs::path shipped() { return default_robot_path().parent_path().parent_path() / "policies" / "superball-paper-t4-n5.json"; }
+fs::path shipped() {
+  return default_robot_path().parent_path().parent_path() / "policies" / "superball-paper-t4-n5.json";
+}
 
 // The end-cap map of `a` after `b`.
 std::vector<int> compose(const Symmetry& a, const Symmetry& b) {
@@ -110,7 +112,8 @@ TEST(SymmetryGroup, ImageMovesEachTableToTheImageCable) {
   EXPECT_FALSE(image.provenance.heading_deg.has_value());
   // A mirror is its own inverse: twice gives the policy back, and it still parses.
   const Policy twice = image_of(image, mirror, robot);
-  for (int m = 0; m < robot.cable_count(); ++m) EXPECT_EQ(twice.cables[m].rest_lengths_m, policy.cables[m].rest_lengths_m);
+  for (int m = 0; m < robot.cable_count(); ++m)
+    EXPECT_EQ(twice.cables[m].rest_lengths_m, policy.cables[m].rest_lengths_m);
   EXPECT_NO_THROW(parse_policy(policy_to_json(image), robot));
   EXPECT_THROW(find_symmetry(group, "(y, x, z)"), PolicyError);
   EXPECT_NO_THROW(find_symmetry(group, "identity"));
@@ -153,7 +156,8 @@ TEST(SymmetryPhysics, MirroredGaitRollsTheMirroredPath) {
   const auto nodes = settled_nodes(robot);
   const Symmetry& id = group.front();
   const double duration_s = 20.0;  // five periods
-  const Eigen::Vector2d d = roll(robot, policy, mirrored_start(robot, nodes, id, Eigen::Matrix3d::Identity()), duration_s);
+  const Eigen::Vector2d d =
+      roll(robot, policy, mirrored_start(robot, nodes, id, Eigen::Matrix3d::Identity()), duration_s);
   ASSERT_GT(d.norm(), 5.0);
   const Eigen::Matrix3d quarter = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector2d dq = roll(robot, policy, mirrored_start(robot, nodes, id, quarter), duration_s);
@@ -167,14 +171,16 @@ TEST(SymmetryPhysics, MirroredGaitRollsTheMirroredPath) {
   for (const Symmetry& s : group) {
     if (s.proper()) continue;
     ++reflections;
-    const Eigen::Vector2d got = roll(robot, image_of(policy, s, robot), mirrored_start(robot, nodes, s, flip_y), duration_s);
+    const Eigen::Vector2d got =
+        roll(robot, image_of(policy, s, robot), mirrored_start(robot, nodes, s, flip_y), duration_s);
     EXPECT_LE((got - want).norm(), tolerance_m) << s.name;
   }
   EXPECT_EQ(reflections, 12);
   // The test can fail: one reflection's gait from another's start does not roll there.
   const Symmetry& a = find_symmetry(group, "(-x,y,z)");
   const Symmetry& b = find_symmetry(group, "(x,-y,z)");
-  const Eigen::Vector2d wrong = roll(robot, image_of(policy, a, robot), mirrored_start(robot, nodes, b, flip_y), duration_s);
+  const Eigen::Vector2d wrong =
+      roll(robot, image_of(policy, a, robot), mirrored_start(robot, nodes, b, flip_y), duration_s);
   EXPECT_GT((wrong - want).norm(), 100.0 * tolerance_m);
 }
 
