@@ -3,7 +3,7 @@
 
 #include <array>
 
-#include "firmware/core/endcap_controller.hpp"
+#include "core/endcap_controller.hpp"
 
 namespace {
 

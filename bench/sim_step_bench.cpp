@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <vector>
 
-#include "sim/benchmark_policy.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/benchmark_policy.hpp"
+#include "sim/model/episode.hpp"
 
 namespace {
 
@@ -28,7 +28,7 @@ void BM_ModelStep(benchmark::State& state) { step_settled(state, load_robot(robo
 BENCHMARK(BM_ModelStep);
 
 // What the strut-gap measurement adds to every step, rod contact or not
-// (sim/model_strut_contact.cpp): the closest points of the 15 strut pairs, here
+// (sim/model/model_strut_contact.cpp): the closest points of the 15 strut pairs, here
 // on the settled pose, beside BM_ModelStep above.
 void BM_StrutGapMeasurement(benchmark::State& state) {
   const Robot robot = load_robot(robot_path_named("superball"));

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sim/analysis/analysis.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::cli {
 

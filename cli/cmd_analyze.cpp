@@ -19,8 +19,8 @@
 #include "cli/commands.hpp"
 #include "cli/episode_json.hpp"
 #include "sim/analysis/csv_files.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "robot/policy.hpp"
 
 extern char** environ;
 

@@ -20,8 +20,8 @@
 #include "cli/evolve_progress.hpp"
 #include "sim/evolve/checkpoint.hpp"
 #include "sim/evolve/driver.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
 
 namespace tensegrity::cli {

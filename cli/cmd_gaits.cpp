@@ -11,10 +11,10 @@
 
 #include "cli/commands.hpp"
 #include "cli/episode_json.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
-#include "sim/gait_set.hpp"
-#include "sim/symmetry.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
+#include "robot/gait_set.hpp"
+#include "robot/symmetry.hpp"
 
 namespace tensegrity::cli {
 namespace {

@@ -24,9 +24,9 @@
 #endif
 #include "hil/hil_error.hpp"
 #include "hil/hil_run.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
+#include "robot/policy.hpp"
 #ifdef TENSEGRITY_CLI_VIEW
 #include "view/modes.hpp"
 #endif

@@ -8,8 +8,8 @@
 
 #include "cli/commands.hpp"
 #include "cli/episode_json.hpp"
-#include "sim/benchmark_policy.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/benchmark_policy.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::cli {
 namespace {

@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <string>
 
-#include "sim/core_controller.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::cli {
 

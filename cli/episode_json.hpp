@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/controller.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::cli {
 

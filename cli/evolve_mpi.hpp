@@ -10,7 +10,7 @@
 
 #include "sim/evolve/config.hpp"
 #include "sim/evolve/evaluator.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::cli {
 

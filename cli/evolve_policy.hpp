@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `tensegrity evolve`'s output: the best team as a policy file, and the gait it plays.
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/coevolution.hpp"
 #include "sim/evolve/config.hpp"
-#include "sim/policy.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::cli {
 

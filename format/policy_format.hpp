@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The policy file ("tensegrity-policy/1"), read once for everyone who reads it: the
-// simulator and the coevolution (sim/policy.hpp, which adds the robot's checks and
+// simulator and the coevolution (robot/policy.hpp, which adds the robot's checks and
 // the provenance), the end cap (firmware/app/policy_file.hpp, its share only), the
 // ground tools and the HIL. The shape is checked here with field paths; rest-length
 // limits are the reader's (an end cap checks its own cables against its own
@@ -13,8 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::format {
 
@@ -36,7 +36,7 @@ struct PolicyDocument {
   double period_s = 0.0;
   int complexity = 0;
   std::vector<PolicyCable> cables;  // in file order
-  nlohmann::json provenance;        // null when absent; read by sim/policy.cpp
+  nlohmann::json provenance;        // null when absent; read by robot/policy.cpp
 };
 
 // Checks the format name, period (0, 3600] s, complexity 1..core::kMaxComplexity,

@@ -12,8 +12,8 @@
 #include <cstring>
 
 #include "cdr_sample.hpp"
-#include "firmware/comms/command_gate.hpp"
-#include "firmware/comms/command_wire.hpp"
+#include "firmware/comms/logic/command_gate.hpp"
+#include "firmware/comms/logic/command_wire.hpp"
 #include "msgs/format_version.hpp"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
 

@@ -13,7 +13,7 @@
 #include <cstring>
 
 #include "cdr_sample.hpp"
-#include "firmware/comms/time_sync_client.hpp"
+#include "firmware/comms/logic/time_sync_client.hpp"
 #include "msgs/format_version.hpp"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "tensegrity_msgs/msg/TimeSyncPubSubTypes.h"

@@ -12,7 +12,7 @@
 
 #include "hil/hil_error.hpp"
 #include "hil/scenario.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace hil = tensegrity::hil;
 

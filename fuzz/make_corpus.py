@@ -127,7 +127,7 @@ def files():
     policies = sorted((ROOT / "policies").glob("*.json"), key=lambda p: p.stat().st_size)[:2]
     for p in policies:
         out("policy_file", p.name, p.read_bytes())
-    out("endcap_config", "example.json", (ROOT / "firmware/app/endcap.example.json").read_bytes())
+    out("endcap_config", "example.json", (ROOT / "firmware/endcap/endcap.example.json").read_bytes())
 
 
 def operator_lines():

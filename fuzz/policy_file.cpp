@@ -8,9 +8,9 @@
 #include <string>
 
 #include "firmware/app/policy_file.hpp"
-#include "firmware/core/limits.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "core/limits.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 namespace sim = tensegrity::sim;
 namespace app = tensegrity::fw::app;

@@ -1,14 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a PolicyTable_ sample off the wire into the end cap's checks
-// (firmware/comms/policy_wire). Oracle: a table the checks accept is one the core
+// (firmware/comms/wire/policy_wire). Oracle: a table the checks accept is one the core
 // accepts too (core::validate) for the same motor count and limits.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 
 #include "cdr_sample.hpp"
-#include "firmware/comms/policy_wire.hpp"
-#include "firmware/core/table.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
+#include "core/table.hpp"
 #include "tensegrity_msgs/msg/PolicyTablePubSubTypes.h"
 
 namespace comms = tensegrity::fw::comms;

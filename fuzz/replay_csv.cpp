@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "view/csv_table.hpp"
 #include "view/replay_data.hpp"
 

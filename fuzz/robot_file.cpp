@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/model.hpp"
-#include "sim/robot.hpp"
+#include "sim/model/model.hpp"
+#include "robot/robot.hpp"
 
 namespace sim = tensegrity::sim;
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/comms/reasons.hpp"
+#include "firmware/comms/wire/reasons.hpp"
 #include "ground/estops_seen.hpp"
 #include "ground/station.hpp"
 

@@ -2,7 +2,7 @@
 // What a clear-fault says it has seen: each addressed end cap's emergency stops
 // (its life id and count) as the tool had heard them when the operator asked, and
 // when that was. An end cap that took another estop since, or one issued after the
-// asking, refuses the clear (firmware/comms/command_gate.hpp, rule 7), so a clear
+// asking, refuses the clear (firmware/comms/logic/command_gate.hpp, rule 7), so a clear
 // held up on the link, queued behind another command, or sent by a tool that first
 // heard the end cap after another tool's estop, cannot undo an estop sent after it.
 #pragma once
@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <functional>
 
-#include "firmware/comms/estop_count.hpp"
+#include "firmware/comms/wire/estop_count.hpp"
 #include "ground/station.hpp"
 
 namespace tensegrity::ground {

@@ -5,7 +5,7 @@
 #include <chrono>
 #include <thread>
 
-#include "firmware/core/endcap_controller.hpp"
+#include "core/endcap_controller.hpp"
 #include "ground/status.hpp"
 
 namespace tensegrity::ground {

@@ -20,7 +20,7 @@
 #include <thread>
 #include <vector>
 
-#include "firmware/comms/estop_count.hpp"
+#include "firmware/comms/wire/estop_count.hpp"
 #include "tensegrity_msgs/msg/Command.h"
 #include "tensegrity_msgs/msg/CommandAck.h"
 #include "tensegrity_msgs/msg/Heartbeat.h"

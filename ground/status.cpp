@@ -5,7 +5,7 @@
 
 #include <cstdio>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 
 namespace tensegrity::ground {
 

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "firmware/comms/policy_wire.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
 #include "ground/station.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::ground {
 

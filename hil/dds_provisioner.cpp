@@ -11,8 +11,8 @@
 #include <ctime>
 #include <limits>
 
-#include "firmware/core/fault.hpp"
-#include "firmware/core/table.hpp"
+#include "core/fault.hpp"
+#include "core/table.hpp"
 #include "ground/command.hpp"
 #include "ground/keystore.hpp"
 #include "ground/station.hpp"

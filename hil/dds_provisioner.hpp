@@ -30,16 +30,16 @@
 #include <thread>
 #include <vector>
 
-#include "firmware/comms/policy_wire.hpp"
-#include "firmware/comms/start_grid.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
+#include "firmware/comms/wire/start_grid.hpp"
 #include "ground/station.hpp"
 #include "hil/dds_domain.hpp"
 #include "hil/provisioner.hpp"
 #include "hil/retry_backoff.hpp"
 #include "hil/start_handshake.hpp"
 #include "hil/world_stepper.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::hil {
 
@@ -56,7 +56,7 @@ struct DdsProvisionerConfig {
   double upload_timeout_s = 10.0;
   double command_timeout_s = 5.0;
   // Lockstep: physics step 0 is this many SYNCs after the freeze: a whole number of
-  // the end caps' start grid (firmware/comms/start_grid.hpp), the loops being frozen meanwhile.
+  // the end caps' start grid (firmware/comms/wire/start_grid.hpp), the loops being frozen meanwhile.
   std::int64_t start_after_ticks = 2 * fw::comms::kLockstepStartGridPeriods;
   // Real time: the start's host time is this far ahead of the command.
   // Real time: the start is placed this far ahead. On this 2-core host the real-time

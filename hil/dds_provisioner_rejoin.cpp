@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 #include "ground/command.hpp"
 #include "hil/dds_provisioner.hpp"
 

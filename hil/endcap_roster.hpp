@@ -13,7 +13,7 @@
 #include "firmware/drivers/spool_geometry.hpp"
 #include "hil/clock.hpp"
 #include "hil/endcap_devices.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::hil {
 

@@ -19,8 +19,8 @@
 #ifdef TENSEGRITY_HIL_DDS
 #include "hil/dds_provisioner.hpp"
 #endif
-#include "sim/episode.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/episode.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::hil {
 

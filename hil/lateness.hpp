@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "firmware/core/histogram.hpp"
+#include "core/histogram.hpp"
 
 namespace tensegrity::hil {
 

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "hil/hil_error.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::hil {
 

@@ -277,7 +277,7 @@ std::string ProcessLauncher::set_dds_link(int e, bool up) {
   return "";
 }
 
-// SIGRTMIN+1: the end cap program's --dds-cut-signals mute (firmware/app/main.cpp).
+// SIGRTMIN+1: the end cap program's --dds-cut-signals mute (firmware/endcap/main.cpp).
 std::string ProcessLauncher::mute_dds(int e) {
   if (!provisioner_.dds_link()) return "this run has no DDS link (provisioner " + provisioner_.name() + ")";
   reap(e, false);

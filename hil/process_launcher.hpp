@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "firmware/app/endcap_stats.hpp"
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 #include "hil/devices/udp_ports.hpp"
 #include "hil/provisioner.hpp"

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::hil {
 

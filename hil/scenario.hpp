@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "hil/udp_hub.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::hil {
 

@@ -54,8 +54,8 @@
 #include "hil/start_handshake.hpp"
 #include "hil/tick_source.hpp"
 #include "hil/udp_hub.hpp"
-#include "sim/model.hpp"
-#include "sim/start_frame.hpp"
+#include "robot/start_frame.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::hil {
 

@@ -3,18 +3,18 @@
 """The architecture's rules, enforced: which room may include which, read from the
 declarative table scripts/layers.json (README "What is here", docs/design/architecture.md).
 
-Every tracked C++ file belongs to the room whose longest file prefix matches it. Each
-#include "..." of another room's file must name a room in its own room's
-may_include (the rooms its CMake target links), and each #include <...> must obey
-the room's system rule ("std": the C++ standard library only, as firmware/core must;
-"forbid": prefixes such as fastdds/ that the room must not touch). A violation names
-the file, the line, the include and the rule.
+A room is one folder of the tree, and every tracked C++ file belongs to the room
+whose folder is the longest prefix of its path (a file in no room's folder is a
+violation too). Each #include "..." of another room's file must name a room in its
+own room's may_include (the rooms its CMake target links), and must not reach a
+room whose folder holds the includer's own (an include that runs back up a floor:
+the rooms a room stands on sit beside it, never above it). Each #include <...> must
+obey the room's system rule ("std": the C++ standard library only, as core/ must;
+"forbid": prefixes such as fastdds/ that the room must not touch). A violation
+names the file, the line, the include and the rule.
 
-The build enforces half of this by itself (cmake/Rooms.cmake): each room's target
-exports an include root holding its own headers only, so a header of a room the
-target does not link does not compile. This script keeps the other half, which
-CMake cannot see: that the rooms a room links are the ones the table allows, and
-the rules on system headers.
+Every target has the source root as its include directory (cmake/Rooms.cmake), so
+the compiler would find any header: this check is what keeps the rooms apart.
 
   scripts/check_layers.py [--self-test]
 """
@@ -46,13 +46,20 @@ unordered_map unordered_set utility valarray variant vector version
 def load_rules(path):
     with open(path, encoding="utf-8") as f:
         doc = json.load(f)
-    if doc.get("format") != "tensegrity-layers/1":
-        sys.exit(f"{path}: format: expected tensegrity-layers/1")
+    if doc.get("format") != "tensegrity-layers/2":
+        sys.exit(f"{path}: format: expected tensegrity-layers/2")
     rooms = {}
+    folders = {}
     for i, r in enumerate(doc["rooms"]):
-        for key in ("name", "files", "may_include"):
+        for key in ("name", "folder", "may_include"):
             if key not in r:
                 sys.exit(f"{path}: rooms[{i}]: missing '{key}'")
+        folder = r["folder"]
+        if not isinstance(folder, str) or not folder.endswith("/") or folder.startswith("/") or ".." in folder:
+            sys.exit(f"{path}: rooms[{i}].folder: expected a folder of the tree ending in '/', got {folder!r}")
+        if folder in folders:
+            sys.exit(f"{path}: rooms[{i}].folder: {folder} is already room '{folders[folder]}'")
+        folders[folder] = r["name"]
         rooms[r["name"]] = r
     for r in rooms.values():
         for other in r["may_include"]:
@@ -64,16 +71,16 @@ def load_rules(path):
 def room_of(path, rooms):
     best, best_len = None, -1
     for r in rooms.values():
-        for prefix in r["files"]:
-            if path.startswith(prefix) and len(prefix) > best_len:
-                best, best_len = r, len(prefix)
+        if path.startswith(r["folder"]) and len(r["folder"]) > best_len:
+            best, best_len = r, len(r["folder"])
     return best
 
 
 def check_file(root, rel, rooms, tracked):
     own = room_of(rel, rooms)
     if own is None:
-        return []
+        # Every C++ file sits in a room's folder: a file outside them is unchecked.
+        return [f"{rel}: in no room's folder (scripts/layers.json)"]
     problems = []
     with open(os.path.join(root, rel), encoding="utf-8", errors="replace") as f:
         for n, line in enumerate(f, 1):
@@ -84,9 +91,14 @@ def check_file(root, rel, rooms, tracked):
             where = f"{rel}:{n}: #include {kind}{name}{'>' if kind == '<' else kind}"
             if kind == '"' and name in tracked:
                 other = room_of(name, rooms)
-                if other is None or other is own or "*" in own["may_include"]:
+                if other is None or other is own:
                     continue
-                if other["name"] not in own["may_include"]:
+                if own["folder"].startswith(other["folder"]):
+                    problems.append(f"{where}: room '{own['name']}' ({own['folder']}) runs back up a floor to room "
+                                    f"'{other['name']}' ({other['folder']}), whose folder holds its own")
+                elif "*" in own["may_include"]:
+                    continue
+                elif other["name"] not in own["may_include"]:
                     problems.append(f"{where}: room '{own['name']}' may not include room '{other['name']}' "
                                     f"(may include: {', '.join(own['may_include']) or 'no other room'})")
             elif kind == "<":
@@ -114,18 +126,19 @@ def tracked_files(root):
 
 def self_test():
     """The checker must catch each kind of violation, and pass a clean tree."""
-    rules = {"format": "tensegrity-layers/1", "rooms": [
-        {"name": "core", "files": ["core/"], "may_include": [], "system": "std"},
-        {"name": "app", "files": ["app/"], "may_include": ["core"], "forbid": ["fastdds/"]},
-        {"name": "prog", "files": ["app/main.cpp"], "may_include": ["core", "app", "net"]},
-        {"name": "net", "files": ["net/"], "may_include": ["core"]}]}
+    rules = {"format": "tensegrity-layers/2", "rooms": [
+        {"name": "core", "folder": "core/", "may_include": [], "system": "std"},
+        {"name": "app", "folder": "app/", "may_include": ["core"], "forbid": ["fastdds/"]},
+        {"name": "prog", "folder": "app/prog/", "may_include": ["core", "app", "net"]},
+        {"name": "net", "folder": "net/", "may_include": ["core"]}]}
     files = {
         "core/a.hpp": "#include <cstdint>\n#include <vector>\n",
         "core/bad.hpp": "#include <unistd.h>\n#include \"app/x.hpp\"\n",
         "app/x.hpp": "#include \"core/a.hpp\"\n#include <fastdds/dds/x.hpp>\n",
         "app/y.cpp": "#include \"net/n.hpp\"\n#include \"app/x.hpp\"\n",
-        "app/main.cpp": "#include \"net/n.hpp\"\n#include \"app/x.hpp\"\n",
+        "app/prog/main.cpp": "#include \"net/n.hpp\"\n#include \"core/a.hpp\"\n#include \"app/x.hpp\"\n",
         "net/n.hpp": "#include \"core/a.hpp\"\n#include \"unknown/not_tracked.hpp\"\n",
+        "stray/s.cpp": "#include \"core/a.hpp\"\n",
     }
     with tempfile.TemporaryDirectory() as d:
         for rel, text in files.items():
@@ -137,7 +150,8 @@ def self_test():
             json.dump(rules, f)
         got = check_tree(d, rules_path, list(files))
     expect = ["core/bad.hpp:1: #include <unistd.h>", "core/bad.hpp:2: #include \"app/x.hpp\"",
-              "app/x.hpp:2: #include <fastdds/dds/x.hpp>", "app/y.cpp:1: #include \"net/n.hpp\""]
+              "app/x.hpp:2: #include <fastdds/dds/x.hpp>", "app/y.cpp:1: #include \"net/n.hpp\"",
+              "app/prog/main.cpp:3: #include \"app/x.hpp\"", "stray/s.cpp: in no room's folder"]
     ok = len(got) == len(expect) and all(any(p.startswith(e) for p in got) for e in expect)
     if not ok:
         print("check_layers self-test FAILED; expected violations:\n  " + "\n  ".join(expect) +

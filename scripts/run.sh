@@ -52,7 +52,7 @@ echo "== in-process simulation of $policy, ${duration} s"
 "$tensegrity" sim --policy "$policy" --duration "$duration"
 
 echo "== HIL: 12 endcap processes over CAN-over-UDP against the ODE model, lockstep, ${duration} s"
-"$tensegrity" hil --policy "$policy" --duration "$duration" --endcap "$bin/firmware/app/endcap" \
+"$tensegrity" hil --policy "$policy" --duration "$duration" --endcap "$bin/firmware/endcap/endcap" \
   --record out/hil-run.csv
 # Debian's interpreter: it is the one python3-matplotlib installs into.
 /usr/bin/python3 tools/plot_run.py out/hil-run.csv out/hil-run.png

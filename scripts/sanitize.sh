@@ -14,12 +14,12 @@ set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"
 jobs="$(nproc)"
-unit='format_tests|core_tests|test_drivers|test_hal|endcap_app_tests|mailbox_tests|comms_tests|msgs_tests|sim_tests|evolve_tests|hil_unit_tests'
+unit='format_tests|core_tests|test_drivers|test_hal|endcap_app_tests|mailbox_tests|comms_tests|msgs_tests|robot_tests|sim_tests|evolve_tests|hil_unit_tests'
 
 run_asan() {
   cmake --preset asan >/dev/null
   cmake --build --preset asan -j "$jobs" --target \
-    format_tests core_tests test_drivers test_hal endcap_app_tests mailbox_tests comms_tests msgs_tests sim_tests evolve_tests \
+    format_tests core_tests test_drivers test_hal endcap_app_tests mailbox_tests comms_tests msgs_tests robot_tests sim_tests evolve_tests \
     hil_unit_tests ground_cli_tests
   ctest --preset asan -L "^($unit)\$"
   ctest --preset asan -R 'RealEndcaps|EndcapProcess'

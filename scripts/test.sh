@@ -19,7 +19,7 @@ cmake --build --preset "$preset" -j "$(nproc)"
 # No source file over 400 lines, no function over 80 (scripts/size-exceptions.txt).
 /usr/bin/python3 scripts/check_size.py -p "build/$preset" --self-test
 # Which room may include which (scripts/layers.json: each room includes only the
-# rooms its target links; firmware/core the C++ standard library only).
+# rooms its target links; core the C++ standard library only).
 /usr/bin/python3 scripts/check_layers.py --self-test
 # A host build without DDS (TENSEGRITY_WITH_DDS=OFF: no msgs, node, ground tools or
 # view) must configure, and its `endcap` program (the firmware for a board without
@@ -28,7 +28,7 @@ cmake --build --preset "$preset" -j "$(nproc)"
 nodds_start=$(date +%s)
 cmake -S . -B build/nodds -G Ninja -DTENSEGRITY_WITH_DDS=OFF -DTENSEGRITY_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build/nodds -j "$(nproc)" --target endcap
-build/nodds/firmware/app/endcap --help >/dev/null
+build/nodds/firmware/endcap/endcap --help >/dev/null
 echo "test: the DDS-off endcap took $(( $(date +%s) - nodds_start )) s"
 ctest --preset "$preset"
 echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"

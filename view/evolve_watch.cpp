@@ -8,11 +8,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/checkpoint.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "view/replay_sink.hpp"
 #include "view/robot_json.hpp"
 

@@ -17,7 +17,7 @@
 #include <string>
 #include <thread>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "view/event_hub.hpp"
 
 namespace eprosima::fastdds::dds {

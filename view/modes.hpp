@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "view/event_hub.hpp"
 #include "view/server.hpp"
 

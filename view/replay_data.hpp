@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::view {
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "view/replay_sink.hpp"
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::view {
 

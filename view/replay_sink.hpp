@@ -4,7 +4,7 @@
 // itself (the best team of an evolution): no CSV in between.
 #include <memory>
 
-#include "sim/telemetry.hpp"
+#include "sim/model/telemetry.hpp"
 #include "view/replay_data.hpp"
 
 namespace tensegrity::view {

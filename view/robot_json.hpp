@@ -5,7 +5,7 @@
 // the description's pose (the live view's pose: telemetry carries no positions).
 #include <string>
 
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::view {
 

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 #include "firmware/hal/can_bus_spec.hpp"
 #include "format/json_reader.hpp"
 

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 #include "firmware/drivers/cia402.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 

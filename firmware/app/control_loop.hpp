@@ -20,7 +20,7 @@
 #include "firmware/app/loop_stats.hpp"
 #include "firmware/app/mailbox.hpp"
 #include "firmware/app/safety.hpp"
-#include "firmware/core/endcap_controller.hpp"
+#include "core/endcap_controller.hpp"
 #include "firmware/drivers/canopen_master.hpp"
 #include "firmware/hal/can_bus.hpp"
 #include "firmware/hal/clock.hpp"

@@ -9,10 +9,10 @@
 #include <array>
 #include <cstdint>
 
-#include "firmware/core/endcap_controller.hpp"
-#include "firmware/core/fault.hpp"
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "core/endcap_controller.hpp"
+#include "core/fault.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::fw::app {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "firmware/app/control_loop.hpp"
-#include "firmware/core/table.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::fw::app {
 LoopSettings make_loop_settings(const EndcapAppConfig& c) {

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "firmware/core/histogram.hpp"
+#include "core/histogram.hpp"
 
 namespace tensegrity::fw::app {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // This end cap's share of a policy file ("tensegrity-policy/1", written by the
-// simulator: sim/policy.hpp), read by the one policy-format parser every process
+// simulator: robot/policy.hpp), read by the one policy-format parser every process
 // uses (format/policy_format.hpp). The share is the cables whose "owner" is this
 // end cap, in increasing cable index (format::endcap_table_of, which the simulator's
 // sim::endcap_table calls too), so motor m plays the same column everywhere.
@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 
 namespace tensegrity::fw::app {
 

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "firmware/core/limits.hpp"
-#include "firmware/core/table.hpp"
+#include "core/limits.hpp"
+#include "core/table.hpp"
 #include "firmware/hal/storage.hpp"
 
 namespace tensegrity::fw::app {

@@ -14,7 +14,7 @@
 
 #include <cstdint>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 #include "firmware/drivers/canopen_master.hpp"
 
 namespace tensegrity::fw::app {

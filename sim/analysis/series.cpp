@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim::analysis {
 

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "sim/telemetry.hpp"
+#include "sim/model/telemetry.hpp"
 
 namespace tensegrity::sim::analysis {
 

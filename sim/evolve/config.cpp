@@ -4,7 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "firmware/core/limits.hpp"
+#include "core/limits.hpp"
 
 namespace tensegrity::sim::evolve {
 

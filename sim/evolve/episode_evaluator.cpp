@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/evolve/episode_evaluator.hpp"
 
-#include "sim/core_controller.hpp"
+#include "sim/model/core_controller.hpp"
 
 namespace tensegrity::sim::evolve {
 

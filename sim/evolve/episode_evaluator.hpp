@@ -6,11 +6,11 @@
 // episode went infeasible.
 #include <memory>
 
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/config.hpp"
 #include "sim/evolve/evaluator.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim::evolve {
 

@@ -9,7 +9,7 @@
 #include "sim/evolve/config.hpp"
 #include "sim/evolve/evaluator.hpp"
 #include "sim/evolve/mpi_wire.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim::evolve {
 

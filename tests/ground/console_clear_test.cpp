@@ -11,7 +11,7 @@
 #include <future>
 #include <thread>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 #include "ground/command.hpp"
 #include "ground/operator_protocol.hpp"
 #include "ground/operator_server.hpp"

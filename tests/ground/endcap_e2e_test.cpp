@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The DDS link end to end with the real firmware: 12 `endcap` programs
-// (firmware/app with its real DDS node, realtime loop on a UDP CAN bus),
+// (firmware/endcap with its real DDS node, realtime loop on a UDP CAN bus),
 // each with its emulated drives and load cell (endcap_device_sim), and the host
 // side through the `tensegrity` program: upload, start, status --once, with a
 // console running as the operator's host. An observer Station in this process (no
@@ -20,8 +20,8 @@
 
 #include "ground/upload.hpp"
 #include "hil/process_launcher.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 #include "tests/ground/subprocess.hpp"
 
 namespace tensegrity::ground {

@@ -18,8 +18,8 @@ import time
 import unittest
 
 TENSEGRITY, ENDCAP, SOURCE = sys.argv.pop(1), sys.argv.pop(1), pathlib.Path(sys.argv.pop(1))
-UNIT = SOURCE / "firmware" / "app" / "endcap@.service"
-SYSUSERS = SOURCE / "firmware" / "app" / "endcap.sysusers"
+UNIT = SOURCE / "firmware" / "endcap" / "endcap@.service"
+SYSUSERS = SOURCE / "firmware" / "endcap" / "endcap.sysusers"
 DOMAIN = "222"
 # A uid no account here has, standing in for the unit's user: the test adds no user.
 UID = 61234

@@ -18,8 +18,8 @@
 #include <set>
 #include <vector>
 
-#include "firmware/comms/reasons.hpp"
-#include "firmware/core/fault.hpp"
+#include "firmware/comms/wire/reasons.hpp"
+#include "core/fault.hpp"
 #include "ground/command.hpp"
 #include "ground/upload.hpp"
 #include "msgs/dds.hpp"

@@ -20,8 +20,8 @@
 #include "firmware/app/policy_store.hpp"
 #include "ground/upload.hpp"
 #include "hil/devices/udp_ports.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 #include "tests/ground/subprocess.hpp"
 
 namespace tensegrity::ground {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The end cap's side of a stalled link (firmware/comms/node_rejoin.cpp), with a real
+// The end cap's side of a stalled link (firmware/comms/node/node_rejoin.cpp), with a real
 // end-cap node (comms_test_node, end cap 3) and hosts in this process. A stalled
 // security handshake cannot be made to order, so its symptom is forged: a host whose
 // heartbeat names other end caps but never this one. Such a host makes the end cap
@@ -25,8 +25,8 @@
 #include "ground/upload.hpp"
 #include "msgs/dds.hpp"
 #include "msgs/security.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
 #include "tests/ground/subprocess.hpp"
 

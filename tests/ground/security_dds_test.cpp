@@ -23,8 +23,8 @@
 #include "msgs/security.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 #include "tests/ground/rogue_time_server.hpp"
 #include "tests/ground/subprocess.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 
 namespace tensegrity::ground {
 namespace {

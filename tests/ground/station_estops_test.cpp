@@ -12,7 +12,7 @@
 #include <chrono>
 #include <thread>
 
-#include "firmware/core/fault.hpp"
+#include "core/fault.hpp"
 #include "ground/station.hpp"
 #include "msgs/dds.hpp"
 #include "msgs/endcap_writers.hpp"

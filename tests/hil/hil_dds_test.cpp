@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "ground/keystore.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 #include "tests/hil/hil_test_support.hpp"
 
 namespace tensegrity::hil {

@@ -8,7 +8,7 @@
 #include "hil/endcap_roster.hpp"
 #include "hil/hil_error.hpp"
 #include "hil_fakes.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::hil {
 namespace {

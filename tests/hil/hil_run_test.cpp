@@ -18,9 +18,9 @@
 #include "hil/hil_run.hpp"
 #include "hil/process_launcher.hpp"
 #include "tests/hil/hil_test_support.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::hil {
 namespace {

@@ -16,8 +16,8 @@
 
 #include "hil/hil_run.hpp"
 #include "hil/scenario.hpp"
-#include "sim/policy.hpp"
-#include "sim/robot.hpp"
+#include "robot/policy.hpp"
+#include "robot/robot.hpp"
 
 // Twelve sanitized end caps (several times slower) and their DDS nodes cannot keep
 // 1 kHz deadlines and the start's time sync on 2 cores: under AddressSanitizer a

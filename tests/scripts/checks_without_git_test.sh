@@ -31,7 +31,7 @@ echo "the three checks pass in a copy without .git ($(wc -l < "$work/listed-copy
 
 # Planted in the copy: a core header over 400 lines that includes an OS header,
 # badly formatted. Each check must name it.
-planted="$copy/firmware/core/planted_for_test.hpp"
+planted="$copy/core/planted_for_test.hpp"
 { echo '#include <unistd.h>'; echo 'int  planted ( ) ;'; printf '// line\n%.0s' $(seq 400); } > "$planted"
 ! (cd "$copy" && scripts/check_format.sh) > "$work/format.txt" 2>&1 || { echo "FAIL: format missed the planted file"; exit 1; }
 grep -q planted_for_test "$work/format.txt" || { echo "FAIL: format did not name the planted file"; exit 1; }

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 namespace tensegrity::sim {
 

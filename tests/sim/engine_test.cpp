@@ -13,8 +13,8 @@
 #include <sstream>
 #include <string>
 
-#include "sim/episode.hpp"
-#include "sim/model.hpp"
+#include "sim/model/episode.hpp"
+#include "sim/model/model.hpp"
 #include "tests/sim/crossing_struts.hpp"
 
 namespace tensegrity::sim {

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Episodes: limits, infeasibility, determinism, telemetry, and the control core
 // driving the model.
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <fstream>
 #include <string>
 
-#include "sim/benchmark_policy.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/benchmark_policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::sim {
 namespace {

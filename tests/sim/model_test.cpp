@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The model's physics: equilibrium, the paper's Figure 4, energy conservation and
 // the strut-spin cure.
-#include "sim/model.hpp"
+#include "sim/model/model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "sim/controller.hpp"
+#include "sim/model/controller.hpp"
 #include "tests/sim/crossing_struts.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::sim {
 namespace {

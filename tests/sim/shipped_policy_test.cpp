@@ -7,10 +7,10 @@
 #include <filesystem>
 #include <string>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 #include "sim/evolve/config.hpp"
-#include "sim/policy.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::sim {
 namespace {

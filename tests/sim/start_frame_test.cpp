@@ -1,15 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // The start frame: a face's canonical face-down pose has yaw 0, the same pose turned
 // about the vertical has that turn as its yaw, and travel is read in the frame.
-#include "sim/start_frame.hpp"
+#include "robot/start_frame.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::sim {
 namespace {

@@ -9,10 +9,10 @@
 #include <limits>
 #include <vector>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
-#include "sim/model.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
+#include "sim/model/model.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::sim {
 namespace {

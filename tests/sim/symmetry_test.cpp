@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The robot's symmetry group, the image of a gait under a symmetry, and the physics
 // agreeing: a mirrored gait, played from the mirrored start, rolls the mirrored path.
-#include "sim/symmetry.hpp"
+#include "robot/symmetry.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <filesystem>
 #include <set>
 
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
 
 namespace tensegrity::sim {
 namespace {

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "sim/benchmark_policy.hpp"
-#include "sim/episode.hpp"
+#include "sim/model/benchmark_policy.hpp"
+#include "sim/model/episode.hpp"
 #include "view/csv_table.hpp"
 #include "view/replay_sink.hpp"
 

@@ -26,7 +26,7 @@
 #include "view/csv_table.hpp"
 #include "view/live_bridge.hpp"
 #include "view/server.hpp"
-// After Eigen (through sim/robot.hpp): it includes <resolv.h>, whose `_res` macro
+// After Eigen (through robot/robot.hpp): it includes <resolv.h>, whose `_res` macro
 // breaks Eigen's parameters of that name.
 #include <httplib.h>
 

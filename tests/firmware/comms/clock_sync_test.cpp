@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include <gtest/gtest.h>
 
-#include "firmware/comms/clock_sync.hpp"
+#include "firmware/comms/wire/clock_sync.hpp"
 
 namespace tensegrity::fw::comms {
 namespace {

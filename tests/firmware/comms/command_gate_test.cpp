@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/command_gate.hpp"
+#include "firmware/comms/logic/command_gate.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "firmware/comms/wire_time.hpp"
+#include "firmware/comms/wire/wire_time.hpp"
 
 namespace tensegrity::fw::comms {
 namespace {

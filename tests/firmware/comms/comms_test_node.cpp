@@ -32,7 +32,7 @@
 #include <thread>
 #include <vector>
 
-#include "firmware/comms/endcap_node.hpp"
+#include "firmware/comms/node/endcap_node.hpp"
 #include "firmware/app/policy_store.hpp"
 #include "firmware/hal/storage.hpp"
 #include "msgs/security.hpp"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/node_config.hpp"
+#include "firmware/comms/node/node_config.hpp"
 
 #include <gtest/gtest.h>
 

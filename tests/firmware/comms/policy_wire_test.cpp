@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "firmware/comms/policy_wire.hpp"
+#include "firmware/comms/wire/policy_wire.hpp"
 #include "msgs/dds.hpp"
 
 namespace tensegrity::fw::comms {

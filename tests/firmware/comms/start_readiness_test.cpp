@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/start_readiness.hpp"
+#include "firmware/comms/logic/start_readiness.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/start_time.hpp"
+#include "firmware/comms/logic/start_time.hpp"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "firmware/comms/wire_time.hpp"
+#include "firmware/comms/wire/wire_time.hpp"
 
 namespace tensegrity::fw::comms {
 namespace {

@@ -16,7 +16,7 @@
 #include <thread>
 
 #include "firmware/app/host_link.hpp"
-#include "firmware/core/endcap_controller.hpp"
+#include "core/endcap_controller.hpp"
 #include "firmware/hal/clock.hpp"
 
 namespace tensegrity::test {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "firmware/comms/time_sync_client.hpp"
+#include "firmware/comms/logic/time_sync_client.hpp"
 
 #include <gtest/gtest.h>
 

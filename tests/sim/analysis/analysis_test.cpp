@@ -11,9 +11,9 @@
 #include <random>
 
 #include "sim/analysis/csv_files.hpp"
-#include "sim/core_controller.hpp"
-#include "sim/episode.hpp"
-#include "sim/policy.hpp"
+#include "sim/model/core_controller.hpp"
+#include "sim/model/episode.hpp"
+#include "robot/policy.hpp"
 
 namespace tensegrity::sim::analysis {
 namespace {

@@ -7,7 +7,7 @@
 #include "sim/evolve/curve_csv.hpp"
 #include "sim/evolve/driver.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "tests/sim/evolve/synthetic.hpp"
 
 namespace tensegrity::sim::evolve {

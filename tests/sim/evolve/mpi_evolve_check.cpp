@@ -17,7 +17,7 @@
 #include "sim/evolve/mpi_evaluator.hpp"
 #include "sim/evolve/mpi_session.hpp"
 #include "sim/evolve/mpi_worker.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 #include "tests/sim/evolve/synthetic.hpp"
 
 namespace tensegrity::sim::evolve {

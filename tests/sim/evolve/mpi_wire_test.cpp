@@ -15,7 +15,7 @@
 
 #include "sim/evolve/episode_evaluator.hpp"
 #include "sim/evolve/episode_setup.hpp"
-#include "sim/robot.hpp"
+#include "robot/robot.hpp"
 
 namespace tensegrity::sim::evolve {
 namespace {
