@@ -180,7 +180,9 @@ void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
                         {"axial_spin_max_rad_per_s", o.gait.axial_spin_max_rad_per_s},
                         {"endcaps_touched_ground", o.gait.endcaps_touched_ground},
                         {"min_strut_gap_m", o.gait.min_strut_gap_m},
-                        {"strut_overlap_s", o.gait.strut_overlap_s}}}};
+                        {"strut_overlap_s", o.gait.strut_overlap_s},
+                        {"heading_deg", o.gait.travel.heading_deg ? nlohmann::json(*o.gait.travel.heading_deg)
+                                                                  : nlohmann::json(nullptr)}}}};
   if (mpi != nullptr) j["rank_loads"] = mpi->loads();
   std::printf("%s\n", j.dump(2).c_str());
 }
@@ -205,6 +207,7 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
               o.gait.axial_spin_rms_rad_per_s, o.gait.axial_spin_max_rad_per_s, o.gait.endcaps_touched_ground);
   std::printf("  struts     %.3f m apart at the closest, overlapping for %.2f s\n", o.gait.min_strut_gap_m,
               o.gait.strut_overlap_s);
+  if (o.gait.travel.heading_deg) std::printf("  heading    %+.1f deg in the start frame\n", *o.gait.travel.heading_deg);
   std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", o.wall_s, rate, o.threads);
   if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
   std::printf("\n");

@@ -25,6 +25,8 @@ struct SimArgs {
   std::string start = "settled";
   bool start_given = false;
   bool json = false;
+  std::string first;  // played for first_s before --policy
+  double first_s = 0.0;
 };
 
 // The drop start lets the description's pose fall; the settled start lets the pose the
@@ -68,12 +70,29 @@ void run_sim(const SimArgs& args) {
     options.telemetry = telemetry.get();
     options.telemetry_every = args.telemetry_every;
   }
+  sim::ModelState after_first;
+  if (!args.first.empty()) {
+    // As the end caps swap tables at a period boundary: the first policy rolls the robot
+    // from the start, and the episode reported is --policy from where it left it.
+    const auto first = make_policy_controller(robot, args.first);
+    sim::EpisodeOptions lead = options;
+    lead.duration_s = args.first_s;
+    lead.telemetry = nullptr;
+    lead.end_state = &after_first;
+    const sim::EpisodeResult r = sim::run_episode(robot, *first, lead);
+    if (!r.feasible) throw CommandError(1, "sim: --first " + args.first + " is infeasible: " + r.infeasible_reason);
+    options.start_state = &after_first;
+    char after[64];
+    std::snprintf(after, sizeof after, " for %.4g s, then ", args.first_s);
+    controller_name = args.first + after + controller_name;
+  }
   const sim::EpisodeResult result = sim::run_episode(robot, *controller, options);
   if (args.json) {
     nlohmann::json j = episode_json(result);
     j["robot"] = robot.name;
     j["robot_hash"] = robot.hash;
     j["controller"] = controller_name;
+    if (!args.first.empty()) j["first"] = {{"policy", args.first}, {"duration_s", args.first_s}};
     j["start"] = start_json(robot, options.start);
     j["dt_s"] = options.dt_s > 0 ? options.dt_s : robot.time_step_s;
     std::printf("%s\n", j.dump(2).c_str());
@@ -111,6 +130,14 @@ void add_sim_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->json, "Print one JSON object instead of the summary");
+  auto* first = cmd->add_option("--first", args->first,
+                                "Play this policy first, for --first-s seconds from the start; the episode reported is "
+                                "--policy from where it left the robot (a gait switch at a period boundary)")
+                    ->check(CLI::ExistingFile)
+                    ->needs(policy);
+  cmd->add_option("--first-s", args->first_s, "With --first: how long it plays, seconds")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->needs(first);
   cmd->callback([args, start] {
     args->start_given = start->count() > 0;
     run_sim(*args);

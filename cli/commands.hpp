@@ -21,6 +21,8 @@ void add_sim_command(CLI::App& app);
 void add_analyze_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_evolve_command(CLI::App& app);
+// `gaits symmetries|transform|set`: the symmetry group's gaits (sim/symmetry.hpp).
+void add_gaits_command(CLI::App& app);
 // `bench evolve`, added by add_bench_command.
 void add_bench_evolve_command(CLI::App& bench);
 // Ground tools over DDS (ground/): one file each.

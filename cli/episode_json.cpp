@@ -2,6 +2,7 @@
 #include "cli/episode_json.hpp"
 
 #include <cstdio>
+#include <string>
 
 #include "sim/model/core_controller.hpp"
 #include "robot/policy.hpp"
@@ -17,6 +18,9 @@ nlohmann::json episode_json(const sim::EpisodeResult& r) {
   return {
       {"distance_m", r.distance_m},
       {"displacement_m", {r.displacement_m.x(), r.displacement_m.y()}},
+      {"displacement_start_m", {r.travel.start_m.x(), r.travel.start_m.y()}},
+      {"heading_deg", r.travel.heading_deg ? nlohmann::json(*r.travel.heading_deg) : nlohmann::json(nullptr)},
+      {"start_frame", {{"yaw_deg", r.travel.yaw_deg}, {"face", r.start_face}}},
       {"feasible", r.feasible},
       {"infeasible_reason", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_reason)},
       {"infeasible_time_s", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_time_s)},
@@ -36,10 +40,23 @@ nlohmann::json episode_json(const sim::EpisodeResult& r) {
   };
 }
 
+void print_heading(const sim::Travel& t, const std::vector<int>& face) {
+  std::string on = "no hull face";
+  if (face.size() == 3)
+    on = "face " + std::to_string(face[0]) + "-" + std::to_string(face[1]) + "-" + std::to_string(face[2]);
+  if (t.heading_deg) {
+    std::printf("  heading        %+8.1f deg in the start frame (dx %.3f, dy %.3f; %s, yaw %+.1f deg)\n",
+                *t.heading_deg, t.start_m.x(), t.start_m.y(), on.c_str(), t.yaw_deg);
+  } else {
+    std::printf("  heading        none (the robot did not move; %s, yaw %+.1f deg)\n", on.c_str(), t.yaw_deg);
+  }
+}
+
 void print_episode_summary(const sim::EpisodeResult& r) {
   if (r.feasible) {
     std::printf("  distance       %8.3f m  (dx %.3f, dy %.3f)\n", r.distance_m, r.displacement_m.x(),
                 r.displacement_m.y());
+    print_heading(r.travel, r.start_face);
   } else {
     std::printf("  INFEASIBLE at t = %.3f s: %s\n", r.infeasible_time_s, r.infeasible_reason.c_str());
   }

@@ -5,6 +5,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "sim/model/controller.hpp"
 #include "sim/model/episode.hpp"
@@ -15,6 +16,8 @@ namespace tensegrity::cli {
 // `path`, else the robot `policy` names (when one is given), else the default robot.
 sim::Robot load_robot_arg(const std::string& path, const std::string& policy = "");
 nlohmann::json episode_json(const sim::EpisodeResult& result);
+// "heading ... in the start frame (...)": where the robot went, as sim, hil and analyze print it.
+void print_heading(const sim::Travel& travel, const std::vector<int>& start_face);
 void print_episode_summary(const sim::EpisodeResult& result);
 std::unique_ptr<sim::Controller> make_policy_controller(const sim::Robot& robot, const std::string& path);
 

@@ -35,6 +35,7 @@ sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveC
   policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
   policy.provenance.min_strut_gap_m = gait.min_strut_gap_m;
   policy.provenance.strut_overlap_s = gait.strut_overlap_s;
+  policy.provenance.heading_deg = gait.travel.heading_deg;
   if (config.dt_s > 0.0) policy.provenance.score_m = gait.feasible ? gait.distance_m : 0.0;
   return gait;
 }

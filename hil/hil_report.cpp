@@ -57,6 +57,10 @@ nlohmann::json to_json(const HilResult& r) {
           {"error", r.error},
           {"mode", to_string(r.mode)},
           {"distance_m", r.distance_m},
+          {"displacement_m", {r.travel.world_m.x(), r.travel.world_m.y()}},
+          {"displacement_start_m", {r.travel.start_m.x(), r.travel.start_m.y()}},
+          {"heading_deg", r.travel.heading_deg ? nlohmann::json(*r.travel.heading_deg) : nlohmann::json(nullptr)},
+          {"start_frame", {{"yaw_deg", r.travel.yaw_deg}, {"face", r.start_face}}},
           {"sim_time_s", sim_s},
           {"run_wall_s", r.stats.run_wall_s},
           {"boot_wall_s", r.stats.boot_wall_s},
@@ -93,6 +97,14 @@ std::string summary_text(const HilResult& r) {
                 to_string(r.mode), r.ok ? "ok" : "FAILED", r.distance_m, r.stats.sim_time_s(), r.stats.run_wall_s,
                 r.stats.run_wall_s > 0 ? r.stats.sim_time_s() / r.stats.run_wall_s : 0.0);
   s << line;
+  if (r.travel.heading_deg) {
+    std::snprintf(
+        line, sizeof line,
+        "heading %+.1f deg in the start frame (dx %.3f, dy %.3f m; world dx %.3f, dy %.3f m, yaw %+.1f deg)\n",
+        *r.travel.heading_deg, r.travel.start_m.x(), r.travel.start_m.y(), r.travel.world_m.x(), r.travel.world_m.y(),
+        r.travel.yaw_deg);
+    s << line;
+  }
   if (!r.ok) s << "reason: " << r.error << "\n";
   std::snprintf(line, sizeof line, "provisioner %s; %d end caps playing at the end, table phases within %.3f ms\n",
                 r.provisioner.c_str(), r.playing, r.max_phase_offset_s * 1e3);

@@ -282,7 +282,9 @@ void collect(const HilOptions& options, RunParts& parts, HilResult& result) {
     result.link = parts.provisioner->link_timing();
   }
   if (parts.stepper) {
-    result.distance_m = parts.stepper->distance_m();
+    result.travel = parts.stepper->travel();
+    result.distance_m = result.travel.distance_m;
+    result.start_face = parts.stepper->start_face();
     result.stats = parts.stepper->stats();
     for (const auto& line : parts.stepper->log()) result.log.push_back(line);
   }

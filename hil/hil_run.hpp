@@ -107,6 +107,8 @@ struct HilResult {
   bool ok = false;
   std::string error;  // why not ok
   double distance_m = 0.0;
+  sim::Travel travel;           // where the robot went, world and start frame
+  std::vector<int> start_face;  // the end caps it stood on at physics step 0
   double duration_s = 0.0;
   StepperMode mode = StepperMode::lockstep;
   StepperStats stats;

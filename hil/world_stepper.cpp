@@ -33,14 +33,23 @@ WorldStepper::WorldStepper(const sim::Robot& robot, const sim::ModelState& start
   model_->restore(start);
   stats_.dt_s = robot.time_step_s;
   preferred_.assign(model_->rest_length_m().begin(), model_->rest_length_m().end());
-  start_centre_ = model_->centre_m();
+  faces_ = sim::hull_faces(robot);
+  start_frame_ = frame_now(*model_, faces_, start_face_);
   out_.reserve(64);
   rx_.reserve(256);
 }
 
-double WorldStepper::distance_m() const {
-  const Eigen::Vector3d d = model_->centre_m() - start_centre_;
-  return std::hypot(d.x(), d.y());
+sim::StartFrame frame_now(const sim::Model& model, const std::vector<sim::HullFace>& faces, std::vector<int>& face) {
+  const std::vector<Eigen::Vector3d> nodes = model.node_positions();
+  const sim::StartFrame frame = sim::start_frame(model.robot(), faces, nodes);
+  face.clear();
+  if (frame.face >= 0) face.assign(faces[frame.face].nodes.begin(), faces[frame.face].nodes.end());
+  return frame;
+}
+
+sim::Travel WorldStepper::travel() const {
+  const Eigen::Vector3d c = model_->centre_m();
+  return sim::travel(start_frame_, {c.x(), c.y()});
 }
 
 void WorldStepper::note(const std::string& line) {
@@ -183,7 +192,7 @@ void WorldStepper::start() {
   }
   for (int e = 0; e < endcap_count(); ++e) roster_.devices(e).release_gate();
   started_ = true;
-  start_centre_ = model_->centre_m();
+  start_frame_ = frame_now(*model_, faces_, start_face_);
 }
 
 void WorldStepper::run(double duration_s) {

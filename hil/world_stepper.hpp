@@ -54,6 +54,7 @@
 #include "hil/start_handshake.hpp"
 #include "hil/tick_source.hpp"
 #include "hil/udp_hub.hpp"
+#include "robot/start_frame.hpp"
 #include "sim/model/model.hpp"
 
 namespace tensegrity::hil {
@@ -110,6 +111,9 @@ struct StepperStats {
   double dt_s = 0.001;
 };
 
+// The start frame of the model's pose now (sim/start_frame.hpp), and the face it stands on.
+sim::StartFrame frame_now(const sim::Model& model, const std::vector<sim::HullFace>& faces, std::vector<int>& face);
+
 class WorldStepper final : private TickAnswers {
  public:
   // `clock` and `stop` are the run's; the clock must outlive the stepper.
@@ -140,7 +144,10 @@ class WorldStepper final : private TickAnswers {
   void run(double duration_s);
 
   const sim::Model& model() const { return *model_; }
-  double distance_m() const;
+  // Where the robot went since physics step 0, in the world and its start frame.
+  sim::Travel travel() const;
+  // The end caps of the hull face the robot stood on at physics step 0.
+  const std::vector<int>& start_face() const { return start_face_; }
   const StepperStats& stats() const { return stats_; }
   EndcapState state(int endcap) const { return roster_.state(endcap); }
   const EndcapDevices& devices(int endcap) const { return roster_.devices(endcap); }
@@ -186,7 +193,9 @@ class WorldStepper final : private TickAnswers {
   Recorder* recorder_ = nullptr;
   std::function<void(const WorldStepper&)> hook_;
   std::vector<double> preferred_;
-  Eigen::Vector3d start_centre_;
+  std::vector<sim::HullFace> faces_;
+  sim::StartFrame start_frame_;
+  std::vector<int> start_face_;
   std::int64_t ticks_ = 0;  // device time in ticks, boot included
   bool started_ = false;
   StepperStats stats_;

@@ -26,7 +26,7 @@ void WorldStepper::hold(StartHandshake& handshake, std::int64_t timeout_ns) {
   } else {
     hold_lockstep(handshake, t0 + timeout_ns);
   }
-  start_centre_ = model_->centre_m();
+  start_frame_ = frame_now(*model_, faces_, start_face_);
   stats_.hold_wall_s = static_cast<double>(source_.now_ns() - t0) * 1e-9;
 }
 

@@ -54,6 +54,11 @@ void read_gait(const json& provenance, const Robot& robot, const std::string& so
     if (s < 0.0) fail(source, "provenance.gait.strut_overlap_s", "must be >= 0");
     pr.strut_overlap_s = s;
   }
+  if (g->contains("heading_deg")) {
+    const double h = finite_number(g->at("heading_deg"), source, "provenance.gait.heading_deg");
+    if (h <= -180.0 || h > 180.0) fail(source, "provenance.gait.heading_deg", "must be within (-180, 180] degrees");
+    pr.heading_deg = h;
+  }
 }
 
 }  // namespace
@@ -86,6 +91,12 @@ void read_provenance(const json& p, const std::string& source, Provenance& pr) {
   if (p.contains("score_m")) pr.score_m = finite_number(p["score_m"], source, "provenance.score_m");
   pr.robot_hash = p.value("robot_hash", "");
   pr.created_by = p.value("created_by", "");
+  if (p.contains("symmetry")) {
+    if (!p["symmetry"].is_string() || p["symmetry"].get<std::string>().empty()) {
+      fail(source, "provenance.symmetry", "must be a non-empty string");
+    }
+    pr.symmetry = p["symmetry"].get<std::string>();
+  }
   read_sizes(p, source, pr);
   const auto m = p.find("mutation");
   if (m == p.end()) return;
@@ -216,7 +227,9 @@ std::string policy_to_json(const Policy& policy) {
                                  {"endcaps_touched_ground", pr.endcaps_touched_ground}};
     if (pr.min_strut_gap_m) doc["provenance"]["gait"]["min_strut_gap_m"] = *pr.min_strut_gap_m;
     if (pr.strut_overlap_s) doc["provenance"]["gait"]["strut_overlap_s"] = *pr.strut_overlap_s;
+    if (pr.heading_deg) doc["provenance"]["gait"]["heading_deg"] = *pr.heading_deg;
   }
+  if (!pr.symmetry.empty()) doc["provenance"]["symmetry"] = pr.symmetry;
   return doc.dump(2) + "\n";
 }
 

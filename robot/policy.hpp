@@ -53,6 +53,12 @@ struct Provenance {
   // overlapped, s; absent in policies written before they were recorded.
   std::optional<double> min_strut_gap_m = std::nullopt;
   std::optional<double> strut_overlap_s = std::nullopt;
+  // The heading the gait rolled in that episode, degrees in its start frame
+  // (sim/start_frame.hpp; from the settled start, the world frame); absent: unknown.
+  std::optional<double> heading_deg = std::nullopt;
+  // For a symmetry's image of another policy (`tensegrity gaits mirror`): the
+  // symmetry, as the image of the description's (x, y, z); empty otherwise.
+  std::string symmetry = "";
 };
 
 struct Policy {

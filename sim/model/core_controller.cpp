@@ -19,6 +19,7 @@ CoreController::CoreController(const Robot& robot, const Policy& policy) {
 }
 
 void CoreController::reset(const Robot&) {
+  synced_ = false;
   for (std::size_t e = 0; e < endcaps_.size(); ++e) {
     auto& endcap = endcaps_[e];
     endcap.clear_fault();
@@ -41,10 +42,15 @@ void CoreController::update(const ControlInput& input, std::span<double> preferr
     const auto& cables = wiring_[e].cables;
     if (cables.empty()) continue;
     for (std::size_t k = 0; k < cables.size(); ++k) tension[k] = input.tension_n[cables[k]];
+    if (!synced_) {
+      for (std::size_t k = 0; k < cables.size(); ++k) commanded[k] = input.rest_length_m[cables[k]];
+      endcaps_[e].reset_commanded(std::span(commanded.data(), cables.size()));
+    }
     endcaps_[e].step(now_ns, input.dt_s, std::span(tension.data(), cables.size()),
                      std::span(commanded.data(), cables.size()));
     for (std::size_t k = 0; k < cables.size(); ++k) preferred[cables[k]] = commanded[k];
   }
+  synced_ = true;
 }
 
 }  // namespace tensegrity::sim

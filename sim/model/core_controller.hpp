@@ -28,6 +28,10 @@ class CoreController final : public Controller {
   std::vector<core::EndcapController> endcaps_;
   std::vector<core::EndcapTable> tables_;
   std::vector<Wiring> wiring_;
+  // The first update sets each core's commanded lengths to the cables' rest lengths, as
+  // an end cap takes its drives' positions at boot: an episode that starts from a
+  // rolling robot's state goes on from its lengths rather than jumping to the initial ones.
+  bool synced_ = false;
 };
 
 }  // namespace tensegrity::sim

@@ -184,6 +184,10 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
 
   std::vector<double> preferred(model.rest_length_m().begin(), model.rest_length_m().end());
   const Eigen::Vector2d start = horizontal(model.centre_m());
+  const std::vector<HullFace> faces = hull_faces(robot);
+  const std::vector<Eigen::Vector3d> start_nodes = model.node_positions();
+  StartFrame frame = start_frame(robot, faces, start_nodes);
+  frame.origin_m = start;
   const auto steps = static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   const double hard_limit = robot.motor.hard_limit_tension_n;
   const int every = std::max(1, options.telemetry_every);
@@ -192,6 +196,7 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
       options.early_end.bar_m > 0.0 ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
 
   EpisodeResult result;
+  if (frame.face >= 0) result.start_face.assign(faces[frame.face].nodes.begin(), faces[frame.face].nodes.end());
   Tally tally(robot, model);
   std::int64_t done = 0;
   for (std::int64_t k = 0; k < steps; ++k) {
@@ -234,12 +239,16 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
     mark_infeasible(result, "state not finite (the model diverged)", static_cast<double>(done) * dt);
   }
   if (options.telemetry != nullptr) options.telemetry->end();
+  if (options.end_state != nullptr) *options.end_state = model.save();
 
   result.steps = done;
   result.sim_time_s = static_cast<double>(done) * dt;
   if (result.feasible) {
     result.displacement_m = horizontal(model.centre_m()) - start;
     result.distance_m = result.displacement_m.norm();
+    result.travel = travel(frame, horizontal(model.centre_m()));
+  } else {
+    result.travel.yaw_deg = travel(frame, start).yaw_deg;
   }
   tally.finish(done, result);
   result.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -5,10 +5,12 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "sim/model/controller.hpp"
 #include "sim/model/model.hpp"
 #include "robot/robot.hpp"
+#include "robot/start_frame.hpp"
 #include "sim/model/telemetry.hpp"
 
 namespace tensegrity::sim {
@@ -32,13 +34,18 @@ struct EpisodeOptions {
   StartKind start = StartKind::settled;
   const ModelState* start_state = nullptr;  // a given pose; overrides `start`
   TelemetrySink* telemetry = nullptr;
-  int telemetry_every = 1;  // record every N-th step
+  int telemetry_every = 1;          // record every N-th step
   EarlyEnd early_end;
+  ModelState* end_state = nullptr;  // when set, the state the episode ended in (to go on from)
 };
 
 struct EpisodeResult {
   double distance_m = 0.0;  // horizontal, centre of the end caps, final minus initial
   Eigen::Vector2d displacement_m = Eigen::Vector2d::Zero();
+  // The same displacement in the start frame (sim/start_frame.hpp) and its heading;
+  // zero and no heading when the episode was infeasible.
+  Travel travel;
+  std::vector<int> start_face;  // the end caps of the hull face the robot started on
   bool feasible = true;
   std::string infeasible_reason;
   double infeasible_time_s = 0.0;

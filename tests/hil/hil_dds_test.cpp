@@ -141,8 +141,8 @@ TEST(HilDds, LinkCutWithContinueKeepsTheGaitGoing) {
   o.scenario.events = {link_event(2.0, FaultKind::cut_dds), link_event(42.0, FaultKind::restore_dds)};
   double at_cut = 0.0, at_restore = 0.0;
   o.after_step = [&](const WorldStepper& s, ProcessLauncher&) {
-    if (s.step_index() == 2000) at_cut = s.distance_m();
-    if (s.step_index() == 42000) at_restore = s.distance_m();
+    if (s.step_index() == 2000) at_cut = s.travel().distance_m;
+    if (s.step_index() == 42000) at_restore = s.travel().distance_m;
   };
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;
@@ -239,7 +239,7 @@ TEST(HilDds, LinkCutWithStopStopsTheGait) {
   o.scenario.events = {link_event(2.0, FaultKind::cut_dds), link_event(38.0, FaultKind::restore_dds)};
   std::vector<double> distance_by_s;
   o.after_step = [&](const WorldStepper& s, ProcessLauncher&) {
-    if (s.step_index() % 1000 == 0) distance_by_s.push_back(s.distance_m());
+    if (s.step_index() % 1000 == 0) distance_by_s.push_back(s.travel().distance_m);
   };
   const HilResult r = run_hil(o);
   ASSERT_TRUE(r.ok) << r.error;

@@ -54,6 +54,17 @@ TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
   // Stronger than the 2 %: what is left is the drives' position quantisation
   // (0.14 um per count: ~1e-7 relative); one table a tick off showed as ~1e-3.
   EXPECT_NEAR(r.distance_m, ref.distance_m, 1e-5 * ref.distance_m) << "a table started off physics step 0";
+  // ... the same way: from the same face, in the same start frame and heading, as
+  // `hil --json` reports them.
+  EXPECT_EQ(r.start_face, ref.start_face);
+  EXPECT_LT((r.travel.start_m - ref.travel.start_m).norm(), 1e-5 * ref.distance_m);
+  ASSERT_TRUE(r.travel.heading_deg.has_value());
+  ASSERT_TRUE(ref.travel.heading_deg.has_value());
+  EXPECT_NEAR(*r.travel.heading_deg, *ref.travel.heading_deg, 1e-3);
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j.at("heading_deg").get<double>(), *r.travel.heading_deg);
+  EXPECT_EQ(j.at("displacement_start_m").at(0).get<double>(), r.travel.start_m.x());
+  EXPECT_EQ(j.at("start_frame").at("face").get<std::vector<int>>(), r.start_face);
   EXPECT_EQ(r.playing, 12);
   EXPECT_EQ(r.max_phase_offset_s, 0.0) << "every table at the same table time at the last SYNC";
   for (const auto& e : r.endcaps) {

@@ -58,6 +58,27 @@ TEST_F(PolicyFile, RoundTrips) {
   std::filesystem::remove(path);
 }
 
+// The heading a gait rolls, in its start frame: absent is unknown, present is checked.
+TEST_F(PolicyFile, HeadingIsOptionalAndChecked) {
+  json doc = good();
+  EXPECT_FALSE(parse_policy(doc.dump(), robot).provenance.heading_deg.has_value());
+  doc["provenance"]["gait"] = {
+      {"axial_spin_rms_rad_per_s", 0.5}, {"axial_spin_max_rad_per_s", 2.0}, {"endcaps_touched_ground", 12}};
+  EXPECT_FALSE(parse_policy(doc.dump(), robot).provenance.heading_deg.has_value());
+  doc["provenance"]["gait"]["heading_deg"] = -124.0;
+  const Policy p = parse_policy(doc.dump(), robot);
+  ASSERT_TRUE(p.provenance.heading_deg.has_value());
+  EXPECT_EQ(*p.provenance.heading_deg, -124.0);
+  EXPECT_EQ(json::parse(policy_to_json(p))["provenance"]["gait"]["heading_deg"], -124.0);
+  doc["provenance"]["gait"]["heading_deg"] = 180.5;
+  EXPECT_THAT(error_of(doc), HasSubstr("p.json: provenance.gait.heading_deg: must be within (-180, 180]"));
+  doc["provenance"]["gait"]["heading_deg"] = "north";
+  EXPECT_THAT(error_of(doc), HasSubstr("provenance.gait.heading_deg: must be a number"));
+  doc["provenance"]["gait"].erase("heading_deg");
+  doc["provenance"]["symmetry"] = 3;
+  EXPECT_THAT(error_of(doc), HasSubstr("provenance.symmetry: must be a non-empty string"));
+}
+
 TEST_F(PolicyFile, EndcapTableHoldsTheOwnedCablesInOrder) {
   json doc = good();
   doc["cables"][9]["rest_lengths_m"][0] = 0.61;   // cable 9 is end cap 2's first

@@ -45,6 +45,10 @@ TEST(ShippedPolicies, EachLoadsWithItsRobotAndRollsTheDistanceItWasScoredWith) {
     const EpisodeResult r = play(robot, policy);
     EXPECT_TRUE(r.feasible) << entry.path() << ": " << r.infeasible_reason;
     EXPECT_NEAR(r.distance_m, policy.provenance.score_m, 1e-6 * policy.provenance.score_m) << entry.path();
+    // ... in the heading it records (its start frame), as exactly as the distance.
+    ASSERT_TRUE(policy.provenance.heading_deg.has_value()) << entry.path();
+    ASSERT_TRUE(r.travel.heading_deg.has_value()) << entry.path();
+    EXPECT_NEAR(*r.travel.heading_deg, *policy.provenance.heading_deg, 1e-4) << entry.path();
     // ... and rolls: on all 12 end caps, its struts not spinning under it. The viscous
     // stand-in's gaits (records in docs/results/policies/) skated at 12-13 rad/s rms,
     // one of them on 4 end caps; a rolling gait's struts turn at 0-2 rad/s rms.
