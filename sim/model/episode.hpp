@@ -34,7 +34,7 @@ struct EpisodeOptions {
   StartKind start = StartKind::settled;
   const ModelState* start_state = nullptr;  // a given pose; overrides `start`
   TelemetrySink* telemetry = nullptr;
-  int telemetry_every = 1;          // record every N-th step
+  int telemetry_every = 1;  // record every N-th step
   EarlyEnd early_end;
   ModelState* end_state = nullptr;  // when set, the state the episode ended in (to go on from)
 };
