@@ -191,9 +191,13 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
   const auto steps = static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   const double hard_limit = robot.motor.hard_limit_tension_n;
   const int every = std::max(1, options.telemetry_every);
-  // Every whole second of simulated time (at least every step).
+  // Every whole second of simulated time (at least every step). A bar no team could
+  // reach in the whole episode (a short one) would end every episode at its first
+  // second and score that second alone: no early end then.
+  const bool bar_reachable =
+      options.early_end.bar_m <= options.early_end.max_speed_m_per_s * static_cast<double>(steps) * dt;
   const std::int64_t check_every =
-      options.early_end.bar_m > 0.0 ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
+      options.early_end.bar_m > 0.0 && bar_reachable ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
 
   EpisodeResult result;
   if (frame.face >= 0) result.start_face.assign(faces[frame.face].nodes.begin(), faces[frame.face].nodes.end());

@@ -42,9 +42,19 @@ class EvolveDt(unittest.TestCase):
             with self.assertRaises(subprocess.CalledProcessError):
                 self.evolve(tmp, "--resume")
 
-    def test_without_dt_the_robots_step_and_no_field(self):
+    def test_without_dt_the_robots_learning_step(self):
+        learning = json.loads((SOURCE / "robots" / "superball-paper.json").read_text())["learning"]
         with tempfile.TemporaryDirectory() as tmp:
             out, policy = self.evolve(tmp)
+            self.assertEqual(out["config"]["dt_s"], learning["time_step_s"])
+            replay = json.loads(run("sim", "--policy", f"{tmp}/p.json", "--duration", "1", "--json"))
+            self.assertEqual(policy["provenance"]["score_m"], replay["distance_m"])
+
+    def test_a_robot_without_a_learning_step_learns_at_its_own_and_no_field(self):
+        robot = SOURCE / "robots" / "superball-spin-held.json"
+        self.assertNotIn("learning", json.loads(robot.read_text()))
+        with tempfile.TemporaryDirectory() as tmp:
+            out, policy = self.evolve(tmp, "--robot", str(robot))
             self.assertNotIn("dt_s", out["config"])
             self.assertEqual(policy["provenance"]["score_m"], out["final_score_m"])
 

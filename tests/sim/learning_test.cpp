@@ -127,6 +127,18 @@ TEST(Learning, AnEpisodeEndsAtTheFirstSecondItCannotReachTheBar) {
   EXPECT_GE(before.distance_m + rule.max_speed_m_per_s * (duration_s - cut.sim_time_s + 1.0), rule.bar_m);
 }
 
+// A bar out of reach of the whole episode (a short one) would end every episode at
+// its first second: the episode runs to its end instead, as without the rule.
+TEST(Learning, AnEpisodeTooShortToReachTheBarRunsToItsEnd) {
+  const Robot robot = load_robot(default_robot_path());
+  const Policy gait = standing(robot);
+  const EarlyEnd rule{3.0, 0.5};  // 3 m needs 6 s at 0.5 m/s
+  const EpisodeResult short_one = play(robot, gait, 5.0, rule);
+  EXPECT_FALSE(short_one.ended_early);
+  EXPECT_EQ(short_one.sim_time_s, play(robot, gait, 5.0, {}).sim_time_s);
+  EXPECT_TRUE(play(robot, gait, 7.0, rule).ended_early);
+}
+
 // The default robot's gait rolls past its bar: the rule never touches it.
 TEST(Learning, AGaitThatReachesTheBarRunsToItsEndUnchanged) {
   const Robot robot = load_robot(default_robot_path());
