@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "bench.hpp"
+#include "bench_steps.hpp"
 #include "firmware/drivers/sdo_abort.hpp"
 
 namespace tensegrity::fw::canopen {
@@ -15,19 +15,6 @@ namespace {
 
 using sim::Bench;
 using ::testing::HasSubstr;
-
-bool has_event(const std::vector<MasterEvent>& events, MasterEventKind kind, std::uint8_t node) {
-  return std::any_of(events.begin(), events.end(),
-                     [&](const MasterEvent& e) { return e.kind == kind && e.node_id == node; });
-}
-
-// Power on, start both nodes, enable the drive: the state an end cap runs in.
-void bring_up(Bench& b) {
-  b.power_on();
-  b.master.start_bring_up(b.clock.now_ns());
-  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::done; }, 200))
-      << to_string(b.master.bring_up_step()) << " " << b.master.bring_up_failure();
-}
 
 TEST(CanopenBringUp, BringUpSetsCspStartsNodesAndEnablesTheDrive) {
   Bench b;

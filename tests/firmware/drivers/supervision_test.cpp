@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "bench.hpp"
+#include "bench_steps.hpp"
 #include "firmware/drivers/cob_id.hpp"
 #include "firmware/drivers/sdo_codec.hpp"
 
@@ -17,13 +17,6 @@ namespace tensegrity::fw::canopen {
 namespace {
 
 using sim::Bench;
-
-void bring_up(Bench& b) {
-  b.power_on();
-  b.master.start_bring_up(b.clock.now_ns());
-  ASSERT_TRUE(b.run_until([&] { return b.master.bring_up_step() == BringUpStep::done; }, 300))
-      << to_string(b.master.bring_up_step()) << " " << b.master.bring_up_failure();
-}
 
 // Every SDO download the master sent to `node`, in order.
 std::vector<SdoMessage> downloads(const Bench& b, std::uint8_t node) {
