@@ -172,6 +172,15 @@ bool cannot_reach_bar(const EarlyEnd& rule, const Model& model, const Eigen::Vec
   return reachable_m < rule.bar_m;
 }
 
+// Steps between early-end checks: every whole second of simulated time (at least
+// every step), or 0 for none. A bar no team could reach in the whole episode (a
+// short one) would end every episode at its first second and score that second
+// alone: no early end then.
+std::int64_t early_end_check_every(const EarlyEnd& rule, std::int64_t steps, double dt) {
+  const bool reachable = rule.bar_m <= rule.max_speed_m_per_s * static_cast<double>(steps) * dt;
+  return rule.bar_m > 0.0 && reachable ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
+}
+
 }  // namespace
 
 EpisodeResult run_episode(const Robot& robot, Controller& controller, const EpisodeOptions& options) {
@@ -191,13 +200,7 @@ EpisodeResult run_episode(const Robot& robot, Controller& controller, const Epis
   const auto steps = static_cast<std::int64_t>(std::llround(options.duration_s / dt));
   const double hard_limit = robot.motor.hard_limit_tension_n;
   const int every = std::max(1, options.telemetry_every);
-  // Every whole second of simulated time (at least every step). A bar no team could
-  // reach in the whole episode (a short one) would end every episode at its first
-  // second and score that second alone: no early end then.
-  const bool bar_reachable =
-      options.early_end.bar_m <= options.early_end.max_speed_m_per_s * static_cast<double>(steps) * dt;
-  const std::int64_t check_every =
-      options.early_end.bar_m > 0.0 && bar_reachable ? std::max<std::int64_t>(1, std::llround(1.0 / dt)) : 0;
+  const std::int64_t check_every = early_end_check_every(options.early_end, steps, dt);
 
   EpisodeResult result;
   if (frame.face >= 0) result.start_face.assign(faces[frame.face].nodes.begin(), faces[frame.face].nodes.end());
