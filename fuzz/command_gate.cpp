@@ -12,6 +12,7 @@
 #include <cstring>
 
 #include "cdr_sample.hpp"
+#include "fuzz_input.hpp"
 #include "firmware/comms/logic/command_gate.hpp"
 #include "firmware/comms/logic/command_wire.hpp"
 #include "msgs/format_version.hpp"
@@ -22,19 +23,7 @@ namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
 
-struct Input {
-  const std::uint8_t* at;
-  std::size_t left;
-  template <typename T>
-  T take() {
-    T v{};
-    const std::size_t n = left < sizeof v ? left : sizeof v;
-    std::memcpy(&v, at, n);
-    at += n;
-    left -= n;
-    return v;
-  }
-};
+using tensegrity::fuzz::Input;
 
 bool addressed(const comms::CommandSample& c, int endcap_id) { return (c.endcap_mask & (1U << endcap_id)) != 0; }
 

@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "cdr_sample.hpp"
+#include "fuzz_input.hpp"
 #include "firmware/comms/logic/time_sync_client.hpp"
 #include "msgs/format_version.hpp"
 #include "tensegrity_msgs/msg/HeartbeatPubSubTypes.h"
@@ -23,19 +24,7 @@ namespace m = tensegrity_msgs::msg::dds_;
 
 namespace {
 
-struct Input {
-  const std::uint8_t* at;
-  std::size_t left;
-  template <typename T>
-  T take() {
-    T v{};
-    const std::size_t n = left < sizeof v ? left : sizeof v;
-    std::memcpy(&v, at, n);
-    at += n;
-    left -= n;
-    return v;
-  }
-};
+using tensegrity::fuzz::Input;
 
 constexpr std::int16_t kEndcap = 3;
 
