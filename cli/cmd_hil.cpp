@@ -178,7 +178,7 @@ void add_hil_command(CLI::App& app) {
   cmd->add_option("--scenario", args->scenario, "Fault scenario (tensegrity-hil-scenario/1 JSON)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--fault", args->faults, "One fault, ENDCAP:FAULT@TIME_S (repeatable), e.g. 3:drive_fault@2.0");
-  cmd->add_option("--record", args->record, "Per-tick CSV: time, centre, rest lengths, tensions");
+  cmd->add_option("--record", args->record, "Run record CSV, one row per physics step (as sim --telemetry)");
   cmd->add_option("--endcap", args->endcap,
                   "The endcap program (default: the one built with this tree, or $TENSEGRITY_ENDCAP)");
   cmd->add_option("--barrier-timeout", args->barrier_timeout_s, "Lockstep: seconds to wait for an end cap's targets")

@@ -125,7 +125,7 @@ void add_sim_command(CLI::App& app) {
                                 "Start: settled (at rest on the ground; default with --policy) or drop "
                                 "(the benchmark's start; default without)")
                     ->check(CLI::IsMember({"settled", "drop"}));
-  cmd->add_option("--telemetry", args->telemetry, "Write per-step telemetry to this CSV file");
+  cmd->add_option("--telemetry", args->telemetry, "Run record CSV, one row per recorded step (as hil --record)");
   cmd->add_option("--telemetry-every", args->telemetry_every, "Record every N-th step")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
