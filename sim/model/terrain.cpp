@@ -23,6 +23,11 @@ double smooth_slope(double t) { return 6.0 * t * (1.0 - t); }
 
 double radians(double deg) { return deg * std::numbers::pi / 180.0; }
 
+// Grid indices are 64-bit integers: beyond this (or at NaN) a position has diverged,
+// and converting it would be undefined. The ground there is taken as level at 0.
+constexpr double kFarM = 1e12;
+bool on_the_grid(double x, double y) { return std::abs(x) < kFarM && std::abs(y) < kFarM; }
+
 }  // namespace
 
 Terrain::Terrain(const Robot& robot)
@@ -46,7 +51,7 @@ double Terrain::node_height_m(std::int64_t i, std::int64_t j) const {
 }
 
 double Terrain::height_m(double x, double y) const {
-  if (!rough()) return 0.0;
+  if (!rough() || !on_the_grid(x, y)) return 0.0;
   const double gx = std::floor(x / spacing_m_);
   const double gy = std::floor(y / spacing_m_);
   const auto i = static_cast<std::int64_t>(gx);
@@ -59,7 +64,7 @@ double Terrain::height_m(double x, double y) const {
 }
 
 Eigen::Vector2d Terrain::gradient(double x, double y) const {
-  if (!rough()) return Eigen::Vector2d::Zero();
+  if (!rough() || !on_the_grid(x, y)) return Eigen::Vector2d::Zero();
   const double gx = std::floor(x / spacing_m_);
   const double gy = std::floor(y / spacing_m_);
   const auto i = static_cast<std::int64_t>(gx);

@@ -147,6 +147,13 @@ TEST(RoughGround, IsSmoothAndWithinItsHeight) {
   }
 }
 
+TEST(RoughGround, FarOrNonFinitePositionsAreLevel) {
+  const Terrain terrain(on_bumps(0.5, 11));
+  EXPECT_EQ(terrain.height_m(1e300, 0.0), 0.0);
+  EXPECT_EQ(terrain.height_m(0.0, std::nan("")), 0.0);
+  EXPECT_EQ(terrain.gradient(-1e300, 1.0), Eigen::Vector2d::Zero());
+}
+
 // A short episode of the paper's robot on bumps, from the drop start.
 ModelState rolled_on(const Robot& robot) {
   ConstantController hold(robot.initial_rest_length_m - 0.1);
