@@ -17,6 +17,8 @@ class CommandError : public std::runtime_error {
 };
 
 void add_sim_command(CLI::App& app);
+// `robustness`: a gait across a perturbation set (sim/analysis/robustness.hpp).
+void add_robustness_command(CLI::App& app);
 // `analyze`: Figures 10-12 of one episode (sim/analysis/).
 void add_analyze_command(CLI::App& app);
 void add_bench_command(CLI::App& app);

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "tensegrity 0.1.0");
   tensegrity::cli::add_sim_command(app);
+  tensegrity::cli::add_robustness_command(app);
   tensegrity::cli::add_analyze_command(app);
   tensegrity::cli::add_bench_command(app);
   tensegrity::cli::add_evolve_command(app);
