@@ -70,8 +70,13 @@ std::string make_plots(const std::filesystem::path& dir) {
   int status = 0;
   waitpid(pid, &status, 0);
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "written";
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 3) return "skipped: matplotlib is not installed for " + py;
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return "skipped: " + py + " not found";
+  // tools/plot_analysis.py's own status when it cannot import matplotlib.
+  constexpr int kNoMatplotlib = 3;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kNoMatplotlib)
+    return "skipped: matplotlib is not installed for " + py;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == exit_status(ExitCode::cannot_exec)) {
+    return "skipped: " + py + " not found";
+  }
   return "failed: " + py + " " + script + " exited with status " + std::to_string(status);
 }
 
@@ -88,7 +93,8 @@ void run_analyze(const AnalyzeArgs& args) {
   std::fprintf(stderr, "analyze: %s on %s, %.0f s episode at %.0f Hz...\n", args.policy.c_str(), robot.name.c_str(),
                args.duration_s, 1.0 / (options.telemetry_every * robot.time_step_s));
   const sim::EpisodeResult result = sim::run_episode(robot, controller, options);
-  if (series.samples() < 4) throw CommandError(1, "analyze: the episode ended before 4 samples were recorded");
+  if (series.samples() < 4)
+    throw CommandError(ExitCode::failure, "analyze: the episode ended before 4 samples were recorded");
 
   sim::analysis::AnalysisOptions analysis_options;
   analysis_options.period_s = policy.period_s;

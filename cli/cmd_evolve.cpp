@@ -74,14 +74,14 @@ struct RobotArg {
 RobotArg read_robot_arg(const std::string& arg) {
   const std::filesystem::path path = arg.empty() ? sim::default_robot_path() : std::filesystem::path(arg);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw CommandError(2, path.string() + ": cannot open robot description");
+  if (!in) throw CommandError(ExitCode::usage, path.string() + ": cannot open robot description");
   std::ostringstream text;
   text << in.rdbuf();
   try {
     sim::Robot robot = sim::parse_robot(text.str(), path.string());
     return RobotArg{text.str(), std::move(robot)};
   } catch (const sim::RobotError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
 }
 
@@ -114,7 +114,7 @@ sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot
   try {
     config.method = sim::evolve::parse_fitness_method(args.method);
   } catch (const sim::evolve::ConfigError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
   config.population = args.population;
   config.teams = args.teams;
@@ -134,14 +134,15 @@ sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot
   sim::evolve::set_default_early_end(config, robot);
   if (args.early_end_m >= 0.0) {
     if (args.early_end_m > 0.0 && config.early_end_speed_m_per_s <= 0.0) {
-      throw CommandError(2, "--early-end: the robot has no learning.early_end.max_speed_m_per_s to bound progress by");
+      throw CommandError(ExitCode::usage,
+                         "--early-end: the robot has no learning.early_end.max_speed_m_per_s to bound progress by");
     }
     config.early_end_bar_m = args.early_end_m;
   }
   try {
     sim::evolve::validate(config);
   } catch (const sim::evolve::ConfigError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
   return config;
 }
@@ -238,7 +239,7 @@ EvolveOutcome evolve(const EvolveArgs& args, const sim::evolve::EvolveConfig& co
                     try {
                       return sim::evolve::drive(config, evaluator, options);
                     } catch (const sim::evolve::CheckpointError& e) {
-                      throw CommandError(3, e.what());
+                      throw CommandError(ExitCode::checkpoint, e.what());
                     }
                   }(),
                   sim::evolve::TeamResult{}, 0.0, 0, sim::EpisodeResult{}};
@@ -381,7 +382,8 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "Print a JSON summary");
   add_mpi_options(*cmd, *args);
   cmd->callback([args] {
-    if (args->resume && args->checkpoint.empty()) throw CommandError(2, "--resume needs --checkpoint DIR");
+    if (args->resume && args->checkpoint.empty())
+      throw CommandError(ExitCode::usage, "--resume needs --checkpoint DIR");
     check_evolve_launch(args->mpi);
     if (!args->mpi) {
       run_evolve(*args, nullptr);
