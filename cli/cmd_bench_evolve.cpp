@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/evolve/curve_csv.hpp"
 #include "sim/evolve/driver.hpp"
 #include "sim/evolve/episode_evaluator.hpp"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/core_controller.hpp"
 #include "sim/model/episode.hpp"
 #include "robot/gait_set.hpp"

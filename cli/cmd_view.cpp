@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "cli/ground_cli.hpp"
 #include "cli/view_options.hpp"
 #include "msgs/dds.hpp"
