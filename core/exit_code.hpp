@@ -7,11 +7,11 @@
 namespace tensegrity {
 
 enum class ExitCode : int {
-  ok = 0,          // done as asked
-  failure = 1,     // it ran and did not succeed: a check failed, end caps did not confirm, a run failed
-  usage = 2,       // refused before it ran: an option, a file or a configuration it cannot use
-  checkpoint = 3,  // `evolve`: the checkpoint directory cannot be resumed or written
-  mpi = 4,         // `evolve --mpi`: the MPI job failed (no MPI session, or a rank gave up)
+  ok = 0,             // done as asked
+  failure = 1,        // it ran and did not succeed: a check failed, end caps did not confirm, a run failed
+  usage = 2,          // refused before it ran: an option, a file or a configuration it cannot use
+  checkpoint = 3,     // `evolve`: the checkpoint directory cannot be resumed or written
+  mpi = 4,            // `evolve --mpi`: the MPI job failed (no MPI session, or a rank gave up)
   cannot_exec = 127,  // a child process could not run its program (the shell's code for it)
 };
 
