@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "sim/model/episode_json.hpp"
 #include "robot/perturbation_set.hpp"
 #include "robot/policy.hpp"
 #include "sim/analysis/robustness.hpp"
@@ -37,7 +37,7 @@ std::filesystem::path set_path(const std::string& given) {
   const std::filesystem::path in_source = std::filesystem::path(TENSEGRITY_SOURCE_DIR) / kDefaultSet;
   if (std::filesystem::exists(in_source)) return in_source;
 #endif
-  throw CommandError(2, std::string("robustness: no perturbation set: ") + kDefaultSet + " not found; give --set FILE");
+  throw CommandError(ExitCode::usage, std::string("robustness: no perturbation set: ") + kDefaultSet + " not found; give --set FILE");
 }
 
 nlohmann::json case_json(const sim::RobustnessCase& c) {
@@ -105,7 +105,7 @@ void run_robustness(RobustnessArgs args) {
   const sim::RobustnessReport report =
       sim::run_robustness(robot, policy, set, sim::RobustnessOptions{args.duration_s, args.threads});
   if (!report.nominal.feasible) {
-    throw CommandError(1,
+    throw CommandError(ExitCode::failure,
                        "robustness: the gait is infeasible on the robot itself: " + report.nominal.infeasible_reason);
   }
   if (args.json) {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/benchmark_policy.hpp"
 #include "sim/model/episode.hpp"
 
@@ -80,7 +80,8 @@ void run_sim(const SimArgs& args) {
     lead.telemetry = nullptr;
     lead.end_state = &after_first;
     const sim::EpisodeResult r = sim::run_episode(robot, *first, lead);
-    if (!r.feasible) throw CommandError(1, "sim: --first " + args.first + " is infeasible: " + r.infeasible_reason);
+    if (!r.feasible)
+      throw CommandError(ExitCode::failure, "sim: --first " + args.first + " is infeasible: " + r.infeasible_reason);
     options.start_state = &after_first;
     char after[64];
     std::snprintf(after, sizeof after, " for %.4g s, then ", args.first_s);

@@ -33,13 +33,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return exit_status(tensegrity::parse_exit(app.exit(e)));
   } catch (const tensegrity::cli::CommandError& e) {
     std::fprintf(stderr, "tensegrity: %s\n", e.what());
-    return e.exit_code();
+    return exit_status(e.code());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tensegrity: error: %s\n", e.what());
-    return 1;
+    return exit_status(tensegrity::ExitCode::failure);
   }
-  return 0;
+  return exit_status(tensegrity::ExitCode::ok);
 }
