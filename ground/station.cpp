@@ -5,6 +5,7 @@
 #include <chrono>
 #include <ctime>
 
+#include "firmware/hal/monotonic.hpp"
 #include "ground/station_dds.hpp"
 #include "tensegrity_msgs/msg/CommandAckPubSubTypes.h"
 #include "tensegrity_msgs/msg/CommandPubSubTypes.h"
@@ -16,11 +17,7 @@
 
 namespace tensegrity::ground {
 
-std::int64_t Station::now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+std::int64_t Station::now_ns() { return fw::monotonic_ns(); }
 
 Station::Station(const StationOptions& options) : options_(options), dds_(std::make_unique<Dds>()) {
   Dds& d = *dds_;

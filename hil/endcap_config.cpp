@@ -21,7 +21,7 @@ fw::app::EndcapAppConfig endcap_config(const LauncherConfig& lc, int motors, std
   c.initial_rest_length_m = lc.spool.initial_rest_length_m;
   c.limits = lc.limits;
   c.storage_dir = store;
-  c.loop_rate_hz = lc.loop_rate_hz;
+  c.loop_period_ns = lc.loop_period_ns;
   c.mode = lc.mode == StepperMode::realtime ? fw::app::LoopMode::realtime : fw::app::LoopMode::lockstep;
   c.drive_heartbeat_timeout_s = 0.1;
   c.load_cell_heartbeat_timeout_s = 0.1;

@@ -129,6 +129,7 @@ EndcapDeviceSummary EndcapDevices::summary() const {
     s.rpdos += d.rpdos_received();
     s.emcy_sent += d.emcy_sent();
     s.drive_states.push_back(to_string(d.state()));
+    s.drive_period_ns.push_back(d.interpolation_period_ns());
   }
   s.load_cell_stuck = load_cell_.stuck();
   return s;

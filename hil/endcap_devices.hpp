@@ -25,6 +25,8 @@ struct EndcapDeviceSummary {
   std::uint64_t rpdos = 0;
   std::uint64_t emcy_sent = 0;
   std::vector<std::string> drive_states;  // per motor, CiA 402 state name
+  // Per motor, the interpolation period (0x60C2) its end cap gave it: the robot's step.
+  std::vector<std::int64_t> drive_period_ns;
   bool load_cell_stuck = false;
 };
 

@@ -50,7 +50,8 @@ nlohmann::json to_json(const HilResult& r) {
                        {"injected_drops", s.bus.injected_drops},
                        {"injected_corrupt", s.bus.injected_corrupt},
                        {"emcy_sent", s.devices.emcy_sent},
-                       {"drive_states", s.devices.drive_states}});
+                       {"drive_states", s.devices.drive_states},
+                       {"drive_period_ns", s.devices.drive_period_ns}});
   }
   const double sim_s = r.stats.sim_time_s();
   return {{"ok", r.ok},

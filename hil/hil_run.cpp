@@ -166,11 +166,12 @@ LauncherConfig launcher_config(const HilOptions& options, const sim::Robot& robo
     lc.motors_per_endcap.push_back(static_cast<int>(robot.cables_of(e).size()));
   lc.hub_port = hub_port;
   lc.mode = options.mode;
-  lc.loop_rate_hz = endcap_loop_rate_hz(robot);
+  lc.loop_period_ns = endcap_period_ns(robot);
   // The end cap's default spool: 446464 counts/rev on a 10 mm radius, 7.1e6
   // counts per metre, 0.14 um per count: about 1/1400 of one tick's motor
   // travel at 0.2 m/s, so the counts quantisation is negligible.
-  lc.spool = fw::SpoolGeometry{0.01, 4096.0 * 109.0, robot.initial_rest_length_m};
+  lc.spool = fw::SpoolGeometry{};
+  lc.spool.initial_rest_length_m = robot.initial_rest_length_m;
   lc.limits = robot.motor;
   lc.keep_dir = options.keep_dir;
   lc.never_start = options.never_start;

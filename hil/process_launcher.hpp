@@ -18,6 +18,7 @@
 
 #include "firmware/app/endcap_stats.hpp"
 #include "core/limits.hpp"
+#include "core/loop_period.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
 #include "hil/devices/udp_ports.hpp"
 #include "hil/provisioner.hpp"
@@ -31,7 +32,7 @@ struct LauncherConfig {
   std::vector<int> motors_per_endcap;  // from the robot; default 2 each
   std::uint16_t hub_port = 0;
   StepperMode mode = StepperMode::lockstep;
-  double loop_rate_hz = 1000.0;  // the end caps' loop: the robot's time step (loop_rate.hpp)
+  std::int64_t loop_period_ns = core::kDefaultLoopPeriodNs;  // the robot's time step (loop_rate.hpp)
   fw::SpoolGeometry spool;
   core::MotorLimits limits;
   bool keep_dir = false;                               // leave configs, stores and logs behind (debugging)

@@ -7,6 +7,7 @@
 
 #include "firmware/drivers/pdo_codec.hpp"
 #include "hil/hil_error.hpp"
+#include "hil/loop_rate.hpp"
 
 namespace tensegrity::hil {
 
@@ -25,8 +26,7 @@ WorldStepper::WorldStepper(const sim::Robot& robot, const sim::ModelState& start
     : model_(std::make_unique<sim::Model>(robot, robot.time_step_s)),
       hub_(hub),
       config_(config),
-      source_(clock, static_cast<std::int64_t>(std::llround(robot.time_step_s * 1e9)), std::move(stop),
-              config.answer_nap_fraction),
+      source_(clock, endcap_period_ns(robot), std::move(stop), config.answer_nap_fraction),
       roster_(robot, config.spool, config.mode == StepperMode::lockstep, processes),
       faults_({}, robot.time_step_s),
       fault_target_(roster_, hub) {

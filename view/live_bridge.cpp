@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/hal/monotonic.hpp"
 #include "ground/status.hpp"
 #include "msgs/dds.hpp"
 #include "msgs/endcap_writers.hpp"
@@ -67,11 +68,7 @@ struct LiveBridge::Dds {
   ~Dds() { msgs::delete_participant(participant); }
 };
 
-std::int64_t LiveBridge::now_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+std::int64_t LiveBridge::now_ns() { return fw::monotonic_ns(); }
 
 LiveBridge::LiveBridge(const sim::Robot& robot, const LiveOptions& options, EventHub& hub)
     : robot_(robot), options_(options), hub_(hub), dds_(std::make_unique<Dds>()) {

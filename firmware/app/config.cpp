@@ -38,7 +38,7 @@ void check_whole_ms(const Reader& r, const char* key, double s) {
 }
 
 void parse_timeouts(const Reader& top, EndcapAppConfig& c) {
-  const double period_s = 1.0 / c.loop_rate_hz;
+  const double period_s = static_cast<double>(c.loop_period_ns) * 1e-9;
   // Derived defaults: the producer at least one loop period (it beats from the loop).
   c.endcap_heartbeat_s = std::max(c.endcap_heartbeat_s, std::ceil(period_s * 1e3) * 1e-3);
   c.drive_consumer_heartbeat_s = 5.0 * c.endcap_heartbeat_s;
@@ -147,9 +147,10 @@ void parse_spool_and_limits(const Reader& top, EndcapAppConfig& c) {
 void parse_loop(const Reader& top, EndcapAppConfig& c) {
   if (!top.has("loop")) return;
   const Reader loop = top.object("loop");
-  loop.only({"rate_hz", "mode"});
-  c.loop_rate_hz = loop.positive("rate_hz", 1000.0);
-  if (c.loop_rate_hz > 10'000.0) loop.fail("rate_hz", "must be at most 10000");
+  if (loop.has("rate_hz")) loop.fail("rate_hz", "replaced by period_ns, the loop's period (1000 Hz: 1000000)");
+  loop.only({"period_ns", "mode"});
+  if (loop.has("period_ns")) c.loop_period_ns = loop.integer("period_ns");
+  if (const std::string why = loop_period_problem(c.loop_period_ns); !why.empty()) loop.fail("period_ns", why);
   if (loop.has("mode")) {
     const std::string mode = loop.string("mode");
     if (mode == "realtime") {
@@ -166,7 +167,18 @@ void parse_loop(const Reader& top, EndcapAppConfig& c) {
 
 const char* to_string(LoopMode mode) { return mode == LoopMode::lockstep ? "lockstep" : "realtime"; }
 
-std::int64_t EndcapAppConfig::period_ns() const { return static_cast<std::int64_t>(std::llround(1e9 / loop_rate_hz)); }
+std::string loop_period_problem(std::int64_t period_ns) {
+  if (period_ns < core::kMinLoopPeriodNs || period_ns > core::kMaxLoopPeriodNs) {
+    return "must be " + std::to_string(core::kMinLoopPeriodNs) + ".." + std::to_string(core::kMaxLoopPeriodNs) +
+           " ns (the loop runs at 1 Hz to 10 kHz), not " + std::to_string(period_ns);
+  }
+  if (period_ns % 1'000 != 0)
+    return "must be whole microseconds (the drives' 0x1006), not " + std::to_string(period_ns);
+  if (!canopen::interpolation_period(period_ns)) {
+    return "must be at most 255 times a power of ten ns (the drives' 0x60C2), not " + std::to_string(period_ns);
+  }
+  return "";
+}
 
 EndcapAppConfig parse_config(const std::string& json_text, int endcap_id, const std::string& source) {
   const json doc = format::parse_json<ConfigError>(json_text, source);
@@ -229,7 +241,7 @@ std::string config_to_json_text(const EndcapAppConfig& c) {
         {"overload", core::to_string(l.overload)}}},
       {"initial_rest_length_m", c.initial_rest_length_m},
       {"storage_dir", c.storage_dir.string()},
-      {"loop", {{"rate_hz", c.loop_rate_hz}, {"mode", to_string(c.mode)}}},
+      {"loop", {{"period_ns", c.loop_period_ns}, {"mode", to_string(c.mode)}}},
       {"timeouts",
        {{"drive_heartbeat_s", c.drive_heartbeat_timeout_s},
         {"load_cell_heartbeat_s", c.load_cell_heartbeat_timeout_s},

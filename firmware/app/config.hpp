@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/loop_period.hpp"
 #include "core/limits.hpp"
 #include "firmware/drivers/cia402.hpp"
 #include "firmware/drivers/spool_geometry.hpp"
@@ -23,7 +24,7 @@ class ConfigError : public std::runtime_error {
 };
 
 enum class LoopMode : std::uint8_t {
-  realtime,  // own absolute-deadline timer at rate_hz; the end cap sends SYNC
+  realtime,  // own absolute-deadline timer every period_ns; the end cap sends SYNC
   lockstep,  // one cycle per SYNC received from the bus (the HIL owns time)
 };
 
@@ -39,12 +40,15 @@ struct EndcapAppConfig {
   // The tension guard (cut-off and hard limit) from the load cell's readings; off
   // only by "tension_guard": "off" (no load cell), warned about at every start.
   bool use_load_cell = true;
-  double spool_radius_m = 0.01;
-  double counts_per_rev = 4096.0 * 109.0;
+  double spool_radius_m = SpoolGeometry{}.spool_radius_m;
+  double counts_per_rev = SpoolGeometry{}.counts_per_rev;
   core::MotorLimits limits{};
   double initial_rest_length_m = 0.95;  // rest length at drive count 0 (homing)
   std::filesystem::path storage_dir = "/var/lib/tensegrity/endcap";
-  double loop_rate_hz = 1000.0;
+  // The loop's period, which is also the SYNC period and the drives' interpolation
+  // period (bring-up writes it to them): core/loop_period.hpp's limits, whole
+  // microseconds, and a value 0x60C2 can say.
+  std::int64_t loop_period_ns = core::kDefaultLoopPeriodNs;
   LoopMode mode = LoopMode::realtime;
   double drive_heartbeat_timeout_s = 0.1;
   double load_cell_heartbeat_timeout_s = 0.1;
@@ -70,9 +74,12 @@ struct EndcapAppConfig {
   // --keystore or an explicit --insecure (docs/guide/security.md).
   std::filesystem::path dds_keystore;
 
-  std::int64_t period_ns() const;
   SpoolGeometry spool() const { return SpoolGeometry{spool_radius_m, counts_per_rev, initial_rest_length_m}; }
 };
+
+// Why the loop cannot run at this period ("" when it can): the config's check of
+// loop.period_ns, and the HIL's of a robot's step before it launches end caps.
+std::string loop_period_problem(std::int64_t period_ns);
 
 // The one writer of the format, beside its one reader: every field, so that
 // parse_config(config_to_json_text(c), c.endcap_id) == c. The HIL's launcher

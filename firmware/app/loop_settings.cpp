@@ -36,13 +36,14 @@ LoopSettings make_loop_settings(const EndcapAppConfig& c) {
   s.safety.use_load_cell = c.use_load_cell;
   s.safety.load_cell_sample_timeout_ns = core::seconds_to_ns(c.load_cell_sample_timeout_s);
   s.mode = c.mode;
-  s.period_ns = c.period_ns();
+  s.period_ns = c.loop_period_ns;
+  s.master.sync_period_ns = c.loop_period_ns;
   s.start_on_boot = c.start_on_boot;
   // The drives stop themselves once no heartbeat came for their consumer time,
   // and the last one may have left a producer period before the loop stopped.
   const std::int64_t consumer_ns = std::int64_t{s.master.drive_consumer_heartbeat_ms} * 1'000'000;
   s.stall_limit_ns = consumer_ns > 0 ? std::max(consumer_ns - s.master.producer_heartbeat_period_ns, s.period_ns) : 0;
-  const double window = std::ceil(c.stats_log_period_s * c.loop_rate_hz);
+  const double window = std::ceil(c.stats_log_period_s * 1e9 / static_cast<double>(c.loop_period_ns));
   s.stats_window_cycles = window < 1.0 ? 1 : static_cast<std::uint64_t>(window);
   return s;
 }

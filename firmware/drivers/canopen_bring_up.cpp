@@ -43,8 +43,9 @@ void CanopenBringUp::fail(const char* what, std::int64_t now_ns, std::uint32_t a
   char where[48];
   const BringUpStep step = step_;
   const bool per_drive = step == BringUpStep::set_mode || step == BringUpStep::check_mode ||
-                         step == BringUpStep::set_heartbeat_consumer || step == BringUpStep::set_abort_connection ||
-                         step == BringUpStep::enable;
+                         step == BringUpStep::set_cycle_period || step == BringUpStep::set_interpolation_value ||
+                         step == BringUpStep::set_interpolation_index || step == BringUpStep::set_heartbeat_consumer ||
+                         step == BringUpStep::set_abort_connection || step == BringUpStep::enable;
   if (step == BringUpStep::set_heartbeat_producer) {  // every node, the load cell last
     const bool drive = drive_index_ < m_.drive_count_;
     std::snprintf(where, sizeof where, "%s (%s %u)", to_string(step), drive ? "drive" : "load cell",
@@ -74,9 +75,12 @@ struct SdoStepSpec {
   std::uint8_t size_bytes;
   const char* what;  // for the failure text
 };
-constexpr std::array<SdoStepSpec, 4> kSdoSteps{{
+constexpr std::array<SdoStepSpec, 7> kSdoSteps{{
     {BringUpStep::set_mode, false, {kOdModesOfOperation, 0}, 1, "writing 0x6060"},
     {BringUpStep::check_mode, true, {kOdModesOfOperationDisplay, 0}, 0, "reading 0x6061"},
+    {BringUpStep::set_cycle_period, false, {kOdCommunicationCyclePeriod, 0}, 4, "writing 0x1006"},
+    {BringUpStep::set_interpolation_value, false, {kOdInterpolationTimePeriod, 1}, 1, "writing 0x60C2 sub 1"},
+    {BringUpStep::set_interpolation_index, false, {kOdInterpolationTimePeriod, 2}, 1, "writing 0x60C2 sub 2"},
     {BringUpStep::set_heartbeat_consumer, false, {kOdConsumerHeartbeatTime, 1}, 4, "writing 0x1016 sub 1"},
     {BringUpStep::set_abort_connection, false, {kOdAbortConnectionOption, 0}, 2, "writing 0x6007"},
 }};
@@ -95,8 +99,14 @@ bool CanopenBringUp::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
   // the end cap falls silent (dead computer, hung loop).
   const bool supervised = m_.config_.drive_consumer_heartbeat_ms > 0 && m_.config_.producer_heartbeat_period_ns > 0;
   std::uint32_t value = 0;
+  // The config checked that 0x60C2 can say the period (app/config.cpp).
+  const InterpolationPeriod interpolation =
+      interpolation_period(m_.config_.sync_period_ns).value_or(InterpolationPeriod{});
   switch (step_) {
     case BringUpStep::set_mode: value = kModeCyclicSynchronousPosition; break;
+    case BringUpStep::set_cycle_period: value = static_cast<std::uint32_t>(m_.config_.sync_period_ns / 1'000); break;
+    case BringUpStep::set_interpolation_value: value = interpolation.value; break;
+    case BringUpStep::set_interpolation_index: value = static_cast<std::uint8_t>(interpolation.index); break;
     case BringUpStep::set_heartbeat_consumer:
       value = consumer_heartbeat_entry(m_.config_.master_node_id, m_.config_.drive_consumer_heartbeat_ms);
       break;
@@ -126,6 +136,11 @@ bool CanopenBringUp::step_drive_sdo(std::int64_t now_ns, BringUpStep& next) {
         fail("drive does not report mode 8 (cyclic synchronous position)", now_ns);
         return true;
       }
+      next = BringUpStep::set_cycle_period;
+      break;
+    case BringUpStep::set_cycle_period: next = BringUpStep::set_interpolation_value; break;
+    case BringUpStep::set_interpolation_value: next = BringUpStep::set_interpolation_index; break;
+    case BringUpStep::set_interpolation_index:
       next = supervised ? BringUpStep::set_heartbeat_consumer : BringUpStep::start_nodes;
       break;
     case BringUpStep::set_heartbeat_consumer: next = BringUpStep::set_abort_connection; break;
@@ -206,6 +221,9 @@ void CanopenBringUp::poll(std::int64_t now_ns) {
       break;
     case BringUpStep::set_mode:
     case BringUpStep::check_mode:
+    case BringUpStep::set_cycle_period:
+    case BringUpStep::set_interpolation_value:
+    case BringUpStep::set_interpolation_index:
     case BringUpStep::set_heartbeat_consumer:
     case BringUpStep::set_abort_connection: {
       BringUpStep next = BringUpStep::idle;

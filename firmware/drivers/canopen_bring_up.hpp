@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // CanopenMaster's start-up sequence (docs/design/canopen.md "Bring-up"): reset
 // communication, wait for every node, set each node's heartbeat period, put each
-// drive in cyclic synchronous position mode and check it, tell each drive to watch
+// drive in cyclic synchronous position mode and check it, give each drive the SYNC
+// period (communication cycle and interpolation period), tell each drive to watch
 // the end cap's heartbeat, start the nodes, enable the drives. One step per poll()
 // so the control loop keeps its period while the nodes come up; each step has a
 // timeout, and a failure names the step and the node. It drives the nodes through
@@ -18,14 +19,17 @@ class CanopenMaster;
 
 enum class BringUpStep : std::uint8_t {
   idle,
-  wait_boot,               // after NMT reset communication: wait for each node's boot-up/heartbeat
-  set_heartbeat_producer,  // SDO 0x1017 = node_heartbeat_period_ms on each drive, then the load cell
-  set_mode,                // SDO 0x6060 = 8 (cyclic synchronous position)
-  check_mode,              // SDO 0x6061 must read 8
-  set_heartbeat_consumer,  // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
-  set_abort_connection,    // SDO 0x6007 = the abort-connection option (with the consumer only)
-  start_nodes,             // NMT start; wait for heartbeats saying operational
-  enable,                  // CiA 402 power-up to operation enabled (needs write_target each cycle)
+  wait_boot,                // after NMT reset communication: wait for each node's boot-up/heartbeat
+  set_heartbeat_producer,   // SDO 0x1017 = node_heartbeat_period_ms on each drive, then the load cell
+  set_mode,                 // SDO 0x6060 = 8 (cyclic synchronous position)
+  check_mode,               // SDO 0x6061 must read 8
+  set_cycle_period,         // SDO 0x1006 = the SYNC period, us
+  set_interpolation_value,  // SDO 0x60C2 sub 1 = the SYNC period's value ...
+  set_interpolation_index,  // ... and sub 2 its power of ten (value x 10^index s)
+  set_heartbeat_consumer,   // SDO 0x1016 sub 1 = end cap's node id, consumer time (skipped when 0)
+  set_abort_connection,     // SDO 0x6007 = the abort-connection option (with the consumer only)
+  start_nodes,              // NMT start; wait for heartbeats saying operational
+  enable,                   // CiA 402 power-up to operation enabled (needs write_target each cycle)
   done,
   failed,
 };

@@ -32,6 +32,9 @@ const char* to_string(BringUpStep step) {
     case BringUpStep::set_heartbeat_producer: return "setting heartbeat producer time";
     case BringUpStep::set_mode: return "setting mode CSP";
     case BringUpStep::check_mode: return "checking mode";
+    case BringUpStep::set_cycle_period: return "setting communication cycle period";
+    case BringUpStep::set_interpolation_value:
+    case BringUpStep::set_interpolation_index: return "setting interpolation time period";
     case BringUpStep::set_heartbeat_consumer: return "configuring heartbeat consumer";
     case BringUpStep::set_abort_connection: return "setting abort connection option";
     case BringUpStep::start_nodes: return "starting nodes";

@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 
+#include "core/loop_period.hpp"
 #include "firmware/drivers/canopen_bring_up.hpp"
 #include "firmware/drivers/cia402.hpp"
 #include "firmware/drivers/cia402_power.hpp"
@@ -51,6 +52,9 @@ struct CanopenMasterConfig {
   std::int64_t sdo_timeout_ns = 50'000'000;
   std::int64_t bring_up_step_timeout_ns = 2'000'000'000;
   std::uint8_t sync_counter_max = 0;  // 0: SYNC without counter; else 2..240
+  // The SYNC period, which bring-up writes to every drive: 0x1006 (whole
+  // microseconds) and 0x60C2 (interpolation_period() must say it).
+  std::int64_t sync_period_ns = core::kDefaultLoopPeriodNs;
   // Supervision the other way (docs/design/canopen.md "Supervision"): the end cap's own
   // node id and heartbeat (its 0x1017; 0: none), which every drive is told to
   // watch in bring-up (0x1016 sub 1, consumer time; 0: not configured) with the

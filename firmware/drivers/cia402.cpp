@@ -3,6 +3,25 @@
 
 namespace tensegrity::fw::canopen {
 
+std::optional<InterpolationPeriod> interpolation_period(std::int64_t period_ns) {
+  if (period_ns <= 0) return std::nullopt;
+  std::int64_t value = period_ns;
+  int index = -9;
+  while (value % 10 == 0 && index < 0) {
+    value /= 10;
+    ++index;
+  }
+  if (value > 255) return std::nullopt;
+  return InterpolationPeriod{static_cast<std::uint8_t>(value), static_cast<std::int8_t>(index)};
+}
+
+std::int64_t period_ns(InterpolationPeriod period) {
+  if (period.index < -9 || period.index > 0) return -1;
+  std::int64_t ns = period.value;
+  for (int i = -9; i < period.index; ++i) ns *= 10;
+  return ns;
+}
+
 const char* to_string(Cia402State state) {
   switch (state) {
     case Cia402State::not_ready_to_switch_on: return "not ready to switch on";

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 namespace tensegrity::fw::canopen {
 
@@ -17,6 +18,21 @@ inline constexpr std::uint16_t kOdPositionActual = 0x6064;
 inline constexpr std::uint16_t kOdVelocityActual = 0x606C;
 inline constexpr std::uint16_t kOdTargetPosition = 0x607A;
 inline constexpr std::int8_t kModeCyclicSynchronousPosition = 8;
+// Communication cycle period (CiA 301, UNSIGNED32, microseconds): the SYNC period.
+inline constexpr std::uint16_t kOdCommunicationCyclePeriod = 0x1006;
+// Interpolation time period (CiA 402): sub 1 the value (UNSIGNED8), sub 2 the index
+// (INTEGER8), value x 10^index seconds: the period at which CSP targets arrive.
+inline constexpr std::uint16_t kOdInterpolationTimePeriod = 0x60C2;
+struct InterpolationPeriod {
+  std::uint8_t value = 1;
+  std::int8_t index = -3;
+};
+// The period as 0x60C2 says it, in its shortest form as drives' manuals write it
+// (1 ms: 1 x 10^-3); none when it cannot (not a value <= 255 times 10^index s,
+// index -9..0).
+std::optional<InterpolationPeriod> interpolation_period(std::int64_t period_ns);
+// The period 0x60C2 says, in ns; -1 for an index outside -9..0.
+std::int64_t period_ns(InterpolationPeriod period);
 // Abort connection option code (INTEGER16): what the drive does by itself when it
 // loses its master (a heartbeat it consumes through 0x1016 times out).
 inline constexpr std::uint16_t kOdAbortConnectionOption = 0x6007;

@@ -153,7 +153,7 @@ void Endcap::start_host_link() {
     node_config.host_boot_grace_s = options_.host_boot_grace_s;
     node_config.unheard_rejoin_s = options_.unheard_rejoin_s;
     if (config_.mode == LoopMode::lockstep) {
-      node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.period_ns();
+      node_config.start_grid_ns = comms::kLockstepStartGridPeriods * config_.loop_period_ns;
     }
     node_config.link_cut = options_.link_cut;
     node_config.mute_requests = options_.dds_mute;
@@ -176,8 +176,8 @@ void Endcap::activate() {
   if (have_table_ && loop_->load_table(table_) != core::TableError::none) {
     log_line("stored table rejected by the core");  // cannot happen: validated when stored
   }
-  log_line("bus %s, %u motor(s), %s at %.0f Hz%s", config_.bus.c_str(), config_.motor_count, to_string(config_.mode),
-           config_.loop_rate_hz, config_.start_on_boot ? ", start on boot" : "");
+  log_line("bus %s, %u motor(s), %s every %lld us%s", config_.bus.c_str(), config_.motor_count, to_string(config_.mode),
+           static_cast<long long>(config_.loop_period_ns / 1'000), config_.start_on_boot ? ", start on boot" : "");
   loop_stop_.store(false);
   loop_thread_ = std::thread([this] {
     while (!loop_stop_.load(std::memory_order_relaxed)) {
@@ -228,7 +228,7 @@ EndcapStats Endcap::stats() const {
   out.final = state_ != State::active;
   out.endcap = config_.endcap_id;
   out.mode = to_string(config_.mode);
-  out.rate_hz = config_.loop_rate_hz;
+  out.rate_hz = 1e9 / static_cast<double>(config_.loop_period_ns);
   out.vm_rss_kb = vm_rss_kb();
   out.link = link_events();
   if (!loop_) return out;

@@ -28,6 +28,8 @@ void SimCia402Drive::on_reset_node() {
   last_controlword_ = 0;
   enable_requested_ = false;
   abort_option_ = AbortConnectionOption::fault_signal;
+  cycle_period_us_ = 0;
+  interpolation_ = {};
 }
 
 // CiA 402 abort connection: the end cap's heartbeat (0x1016) timed out.
@@ -171,8 +173,8 @@ void SimCia402Drive::on_pdo_or_sync(const CanFrame& frame, std::int64_t now_ns, 
   if (ideal_position) {
     // CSP: the target latched at SYNC is reached within the cycle (an ideal drive).
     if (state_ == Cia402State::operation_enabled && mode_ == kModeCyclicSynchronousPosition) {
-      velocity_counts_per_s_ =
-          static_cast<std::int32_t>(static_cast<double>(target_counts_ - position_counts_) / sync_period_s);
+      velocity_counts_per_s_ = static_cast<std::int32_t>(static_cast<double>(target_counts_ - position_counts_) * 1e9 /
+                                                         static_cast<double>(interpolation_period_ns()));
       position_counts_ = target_counts_;
     } else {
       velocity_counts_per_s_ = 0;
@@ -188,6 +190,8 @@ std::uint32_t SimCia402Drive::od_read(SdoAddress a, std::uint32_t& value, std::u
     size = 2;
     return 0;
   }
+  if (a.index == kOdCommunicationCyclePeriod || a.index == kOdInterpolationTimePeriod)
+    return read_period(a, value, size);
   const bool maybe_known = a.index == 0x1000 || (a.index >= kOdControlword && a.index <= kOdTargetPosition);
   if (!maybe_known) return sdo_abort::kNoObject;
   if (a.subindex != 0) return sdo_abort::kNoSubindex;
@@ -225,7 +229,47 @@ std::uint32_t SimCia402Drive::od_read(SdoAddress a, std::uint32_t& value, std::u
   }
 }
 
+std::uint32_t SimCia402Drive::read_period(SdoAddress a, std::uint32_t& value, std::uint8_t& size) const {
+  if (a.index == kOdCommunicationCyclePeriod) {
+    if (a.subindex != 0) return sdo_abort::kNoSubindex;
+    value = cycle_period_us_;
+    size = 4;
+    return 0;
+  }
+  size = 1;
+  switch (a.subindex) {
+    case 0: value = 2; return 0;  // highest sub-index
+    case 1: value = interpolation_.value; return 0;
+    case 2: value = static_cast<std::uint8_t>(interpolation_.index); return 0;
+    default: return sdo_abort::kNoSubindex;
+  }
+}
+
+std::uint32_t SimCia402Drive::write_period(SdoAddress a, std::uint32_t value, std::uint8_t size) {
+  if (a.index == kOdCommunicationCyclePeriod) {
+    if (a.subindex != 0) return sdo_abort::kNoSubindex;
+    if (size != 4) return sdo_abort::kLengthMismatch;
+    cycle_period_us_ = value;
+    return 0;
+  }
+  if (a.subindex != 1 && a.subindex != 2) return a.subindex == 0 ? sdo_abort::kReadOnly : sdo_abort::kNoSubindex;
+  if (size != 1) return sdo_abort::kLengthMismatch;
+  canopen::InterpolationPeriod next = interpolation_;
+  if (a.subindex == 1) {
+    next.value = static_cast<std::uint8_t>(value);
+  } else {
+    next.index = static_cast<std::int8_t>(value & 0xFFU);
+  }
+  // Each sub-index is written alone, so each write must leave a period the drive
+  // can run at: a value of 0 or an index outside -9..0 is refused.
+  if (next.value == 0 || canopen::period_ns(next) < 0) return sdo_abort::kValueRange;
+  interpolation_ = next;
+  return 0;
+}
+
 std::uint32_t SimCia402Drive::od_write(SdoAddress a, std::uint32_t value, std::uint8_t size) {
+  if (a.index == kOdCommunicationCyclePeriod || a.index == kOdInterpolationTimePeriod)
+    return write_period(a, value, size);
   switch (a.index) {
     case kOdModesOfOperation: {
       if (a.subindex != 0) return sdo_abort::kNoSubindex;

@@ -65,7 +65,10 @@ class SimCia402Drive final : public SimNode {
   std::uint16_t last_fault_code() const { return last_fault_code_; }
   std::vector<std::uint16_t> controlwords;  // every controlword received, in order
   bool log_controlwords = true;             // the HIL turns the log off (it would grow)
-  double sync_period_s = 0.001;             // ideal drive: velocity = step / period
+  // The periods its master gave it: 0x1006 (0 until written) and 0x60C2 (power-on
+  // 1 ms); the ideal drive's velocity is the step over the interpolation period.
+  std::int64_t cycle_period_ns() const { return cycle_period_us_ * 1'000; }
+  std::int64_t interpolation_period_ns() const { return canopen::period_ns(interpolation_); }
 
  protected:
   std::uint32_t od_read(canopen::SdoAddress address, std::uint32_t& value, std::uint8_t& size) override;
@@ -76,6 +79,8 @@ class SimCia402Drive final : public SimNode {
 
  private:
   void apply_controlword(std::uint16_t controlword);
+  std::uint32_t read_period(canopen::SdoAddress address, std::uint32_t& value, std::uint8_t& size) const;
+  std::uint32_t write_period(canopen::SdoAddress address, std::uint32_t value, std::uint8_t size);
   void apply_controlword_to_state(std::uint16_t controlword);
 
   canopen::Cia402State state_ = canopen::Cia402State::switch_on_disabled;
@@ -92,6 +97,8 @@ class SimCia402Drive final : public SimNode {
   canopen::AbortConnectionOption abort_option_ = canopen::AbortConnectionOption::fault_signal;
   std::int64_t left_enabled_ns_ = -1;
   std::int64_t now_ns_ = 0;  // of the frame or tick being handled
+  std::uint32_t cycle_period_us_ = 0;
+  canopen::InterpolationPeriod interpolation_{};
 };
 
 }  // namespace tensegrity::hil

@@ -13,7 +13,8 @@ namespace {
 
 // The mutation step's schedule from the options (EvolveRequest says which defaults apply).
 void set_step_schedule(EvolveConfig& config, const EvolveRequest& r) {
-  const bool given = r.sigma_m >= 0.0 || r.sigma_final_m >= 0.0 || r.anneal_episodes >= 0 || r.anneal_start_episodes >= 0;
+  const bool given =
+      r.sigma_m >= 0.0 || r.sigma_final_m >= 0.0 || r.anneal_episodes >= 0 || r.anneal_start_episodes >= 0;
   if (!given && config.mutation == Mutation::gaussian) {
     const auto& s = kDefaultGaussianSchedule;
     config.sigma_m = s.sigma_m;
@@ -63,8 +64,7 @@ EvolveConfig request_config(const EvolveRequest& r, const Robot& robot) {
   return config;
 }
 
-EvolveOutcome run_evolution(const Robot& robot, const EvolveConfig& config, Evaluator& evaluator,
-                            const RunFiles& files,
+EvolveOutcome run_evolution(const Robot& robot, const EvolveConfig& config, Evaluator& evaluator, const RunFiles& files,
                             const std::function<void(const Coevolution&, const GenerationStats&)>& on_generation) {
   // Hours of evolution must not end in "cannot write": make the policy's directory now.
   if (files.policy.has_parent_path()) std::filesystem::create_directories(files.policy.parent_path());

@@ -61,8 +61,7 @@ struct EvolveOutcome {
 };
 
 // Throws CheckpointError when the checkpoint cannot be resumed or written.
-EvolveOutcome run_evolution(const Robot& robot, const EvolveConfig& config, Evaluator& evaluator,
-                            const RunFiles& files,
+EvolveOutcome run_evolution(const Robot& robot, const EvolveConfig& config, Evaluator& evaluator, const RunFiles& files,
                             const std::function<void(const Coevolution&, const GenerationStats&)>& on_generation);
 
 }  // namespace tensegrity::sim::evolve

@@ -101,7 +101,7 @@ class RealEndcaps : public ::testing::Test {
         // device timeouts of seconds keep 24 processes on two shared cores from
         // tripping sensor_timeout / drive_lost when the machine is busy (seen at
         // load average 50 with 1 kHz and 0.5-1 s).
-        {"loop", {{"rate_hz", 250}, {"mode", "realtime"}}},
+        {"loop", {{"period_ns", 4'000'000}, {"mode", "realtime"}}},
         {"timeouts",
          {{"drive_heartbeat_s", 3.0},
           {"load_cell_heartbeat_s", 3.0},

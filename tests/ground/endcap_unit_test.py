@@ -89,7 +89,7 @@ class KeyOwnership(unittest.TestCase):
             "limits": {"min_rest_length_m": 0.6, "max_rest_length_m": 1.1, "speed_m_per_s": 0.2,
                        "cutoff_tension_n": 400, "hard_limit_tension_n": 500},
             "initial_rest_length_m": 0.95, "storage_dir": self.storage,
-            "loop": {"rate_hz": 250, "mode": "realtime"}, "dds_keystore": self.keystore}))
+            "loop": {"period_ns": 4000000, "mode": "realtime"}, "dds_keystore": self.keystore}))
         os.chmod(self.config, 0o644)
 
     def tearDown(self):

@@ -56,7 +56,7 @@ TEST(PersistenceKill, RebootsWithTheOldOrTheNewTableEachUnderItsOwnIdentity) {
         {"hard_limit_tension_n", 500}}},
       {"initial_rest_length_m", 0.95},
       {"storage_dir", (dir / "store").string()},
-      {"loop", {{"rate_hz", 250}, {"mode", "realtime"}}},
+      {"loop", {{"period_ns", 4'000'000}, {"mode", "realtime"}}},
   };
   std::ofstream(dir / "endcap.json") << config.dump(2);
 

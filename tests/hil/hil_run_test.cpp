@@ -100,6 +100,26 @@ TEST_P(HilFidelity, LockstepMatchesInProcessWithinTwoPercent) {
 INSTANTIATE_TEST_SUITE_P(Provisioners, HilFidelity, ::testing::Values(HIL_PROVISIONERS),
                          [](const ::testing::TestParamInfo<Provision>& i) { return std::string(to_string(i.param)); });
 
+// The robot's step reaches the drives: a 2 ms robot's end caps give every emulated
+// drive 2 ms at bring-up (0x1006, 0x60C2), where a drive left alone runs at 1 ms.
+TEST(HilRun, TheDrivesRunAtTheRobotsStep) {
+  std::ifstream in(sim::robot_path_named("superball"));
+  nlohmann::json doc = nlohmann::json::parse(in);
+  doc["time_step_s"] = 0.002;
+  const TempFile robot_file{fs::temp_directory_path() / ("hil_test_robot_2ms_" + std::to_string(::getpid()) + ".json")};
+  std::ofstream(robot_file.path) << doc.dump();
+  HilOptions o = options(1.0, Provision::local);
+  o.robot = robot_file.path;
+  const HilResult r = run_hil(o);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.stats.steps, 500) << "1 s at 2 ms";
+  ASSERT_EQ(r.endcaps.size(), 12U);
+  for (const auto& e : r.endcaps) {
+    ASSERT_EQ(e.devices.drive_period_ns.size(), robot().cables_of(e.endcap).size()) << "end cap " << e.endcap;
+    for (const std::int64_t period : e.devices.drive_period_ns) EXPECT_EQ(period, 2'000'000) << "end cap " << e.endcap;
+  }
+}
+
 TEST(HilRun, BootNamesAnEndCapThatNeverStarted) {
   HilOptions o = options(1.0);
   o.never_start = {7};

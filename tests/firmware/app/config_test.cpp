@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "firmware/app/config.hpp"
+#include "firmware/app/control_loop.hpp"
 #include "firmware/app/policy_file.hpp"
 
 namespace tensegrity::fw::app {
@@ -26,7 +27,7 @@ json example() {
                "cutoff_tension_n": 400, "hard_limit_tension_n": 500},
     "initial_rest_length_m": 0.95,
     "storage_dir": "/tmp/endcap",
-    "loop": {"rate_hz": 500, "mode": "lockstep"}
+    "loop": {"period_ns": 2000000, "mode": "lockstep"}
   })");
 }
 
@@ -46,7 +47,7 @@ TEST(EndcapConfig, ParsesAFullConfig) {
   EXPECT_EQ(c.drive_node_ids[1], 3);
   EXPECT_EQ(c.load_cell_node_id, 2);
   EXPECT_EQ(c.mode, LoopMode::lockstep);
-  EXPECT_EQ(c.period_ns(), 2'000'000);
+  EXPECT_EQ(c.loop_period_ns, 2'000'000);
   EXPECT_DOUBLE_EQ(c.limits.hard_limit_tension_n, 500.0);
   EXPECT_EQ(c.limits.overload, core::Overload::hold) << "absent: the hardware guard";
   EXPECT_FALSE(c.start_on_boot);
@@ -55,7 +56,7 @@ TEST(EndcapConfig, ParsesAFullConfig) {
 TEST(EndcapConfig, TheShippedExampleParses) {
   const EndcapAppConfig c = load_config(ENDCAP_EXAMPLE_CONFIG, 0);
   EXPECT_EQ(c.mode, LoopMode::realtime);
-  EXPECT_EQ(c.loop_rate_hz, 1000.0);
+  EXPECT_EQ(c.loop_period_ns, 1'000'000);
 }
 
 TEST(EndcapConfig, ErrorsNameTheField) {
@@ -124,6 +125,25 @@ std::string policy_json(double value_for_cable_5) {
       .dump();
 }
 
+// One integer period, the one the drives are given (0x1006 in us, 0x60C2 as value
+// x 10^index): a period they cannot be told is refused, naming the field.
+TEST(EndcapConfig, TheLoopPeriodIsOneIntegerTheDrivesCanBeTold) {
+  json j = example();
+  j["loop"]["period_ns"] = 2'500'000;
+  EXPECT_EQ(parse_config(j.dump(), 3).loop_period_ns, 2'500'000);
+  for (const std::int64_t bad :
+       {std::int64_t{99'000}, std::int64_t{2'000'000'000}, std::int64_t{1'000'500}, std::int64_t{1'234'000}}) {
+    j["loop"]["period_ns"] = bad;
+    EXPECT_THAT(error_of(j), HasSubstr("endcap.json: loop.period_ns: must be")) << bad;
+  }
+  j["loop"]["period_ns"] = 0.002;
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: loop.period_ns: must be an integer"));
+  j["loop"].erase("period_ns");
+  j["loop"]["rate_hz"] = 500;
+  EXPECT_THAT(error_of(j), HasSubstr("endcap.json: loop.rate_hz: replaced by period_ns"));
+  EXPECT_EQ(make_loop_settings(parse_config(example().dump(), 3)).master.sync_period_ns, 2'000'000);
+}
+
 TEST(EndcapConfig, SupervisionDefaultsAreDerivedFromTheLoop) {
   EndcapAppConfig c = parse_config(example().dump(), 3);  // 500 Hz
   EXPECT_EQ(c.endcap_node_id, 127);
@@ -132,7 +152,7 @@ TEST(EndcapConfig, SupervisionDefaultsAreDerivedFromTheLoop) {
   EXPECT_DOUBLE_EQ(c.drive_position_timeout_s, 0.02);
   EXPECT_EQ(c.drive_abort_connection, canopen::AbortConnectionOption::quick_stop);
   json slow = example();
-  slow["loop"]["rate_hz"] = 40;  // 25 ms period: the producer beats once a cycle at most
+  slow["loop"]["period_ns"] = 25'000'000;  // 40 Hz: the producer beats once a cycle at most
   slow["timeouts"] = {{"load_cell_sample_s", 0.1}, {"drive_position_s", 0.1}};
   c = parse_config(slow.dump(), 3);
   EXPECT_DOUBLE_EQ(c.endcap_heartbeat_s, 0.025);
@@ -169,7 +189,7 @@ void expect_same(const EndcapAppConfig& a, const EndcapAppConfig& b) {
   EXPECT_EQ(a.limits.overload, b.limits.overload);
   EXPECT_EQ(a.initial_rest_length_m, b.initial_rest_length_m);
   EXPECT_EQ(a.storage_dir, b.storage_dir);
-  EXPECT_EQ(a.loop_rate_hz, b.loop_rate_hz);
+  EXPECT_EQ(a.loop_period_ns, b.loop_period_ns);
   EXPECT_EQ(a.mode, b.mode);
   EXPECT_EQ(a.drive_heartbeat_timeout_s, b.drive_heartbeat_timeout_s);
   EXPECT_EQ(a.load_cell_heartbeat_timeout_s, b.load_cell_heartbeat_timeout_s);

@@ -115,7 +115,7 @@ TEST(EndcapProcess, LockstepOverUdpFollowsThePolicy) {
         {"hard_limit_tension_n", 500}}},
       {"initial_rest_length_m", 0.95},
       {"storage_dir", (dir / "store").string()},
-      {"loop", {{"rate_hz", 1000}, {"mode", "lockstep"}}},
+      {"loop", {{"period_ns", 1'000'000}, {"mode", "lockstep"}}},
       {"timeouts", {{"drive_heartbeat_s", 0.5}, {"load_cell_heartbeat_s", 0.5}, {"load_cell_sample_s", 0.1}}},
   };
   std::ofstream(dir / "endcap.json") << config.dump(2);

@@ -35,6 +35,37 @@ TEST(CanopenBringUp, BringUpSetsCspStartsNodesAndEnablesTheDrive) {
   EXPECT_EQ(b.master.rx_drops().total(), 0U);
 }
 
+// The SYNC period reaches the drive: 0x1006 in microseconds and 0x60C2 as value x
+// 10^index s, which the emulated drive then runs at (its power-on period is 1 ms).
+TEST(CanopenBringUp, BringUpGivesTheDriveTheSyncPeriod) {
+  CanopenMasterConfig config = sim::bench_config();
+  config.sync_period_ns = 2'000'000;
+  Bench b(config);
+  EXPECT_EQ(b.drive.interpolation_period_ns(), 1'000'000);
+  bring_up(b);
+  EXPECT_EQ(b.drive.cycle_period_ns(), 2'000'000);
+  EXPECT_EQ(b.drive.interpolation_period_ns(), 2'000'000);
+}
+
+TEST(CanopenBringUp, TheInterpolationPeriodIsSaidInItsShortestForm) {
+  const auto two_ms = interpolation_period(2'000'000);
+  ASSERT_TRUE(two_ms.has_value());
+  EXPECT_EQ(two_ms->value, 2);
+  EXPECT_EQ(two_ms->index, -3);
+  const auto quarter_ms = interpolation_period(250'000);
+  ASSERT_TRUE(quarter_ms.has_value());
+  EXPECT_EQ(quarter_ms->value, 25);
+  EXPECT_EQ(quarter_ms->index, -5);
+  for (const std::int64_t ns :
+       {std::int64_t{100'000}, std::int64_t{1'000'000}, std::int64_t{2'500'000}, std::int64_t{1'000'000'000}}) {
+    ASSERT_TRUE(interpolation_period(ns).has_value()) << ns;
+    EXPECT_EQ(period_ns(*interpolation_period(ns)), ns);
+  }
+  EXPECT_FALSE(interpolation_period(1'234'000).has_value()) << "more than 255 before a power of ten";
+  EXPECT_FALSE(interpolation_period(0).has_value());
+  EXPECT_EQ(period_ns(InterpolationPeriod{1, 1}), -1);
+}
+
 TEST(CanopenBringUp, BringUpFailsClearlyWhenTheDriveIsSilent) {
   Bench b;
   b.load_cell.boot(0, b.device_log);  // the load cell is there, the drive is not

@@ -62,10 +62,15 @@ TEST(CanopenSupervision, BringUpWritesConsumerHeartbeatAndAbortOptionBeforeStart
   Bench b;
   bring_up(b);
   std::vector<SdoMessage> d = downloads(b, 3);
-  ASSERT_EQ(d.size(), 4U);
+  ASSERT_EQ(d.size(), 7U);
   EXPECT_EQ(d[0].address.index, kOdProducerHeartbeatTime);
   d.erase(d.begin());
   EXPECT_EQ(d[0].address.index, kOdModesOfOperation);
+  // The SYNC period (BringUpGivesTheDriveTheSyncPeriod checks the values).
+  EXPECT_EQ(d[1].address.index, kOdCommunicationCyclePeriod);
+  EXPECT_EQ(d[2].address.index, kOdInterpolationTimePeriod);
+  EXPECT_EQ(d[3].address.index, kOdInterpolationTimePeriod);
+  d.erase(d.begin() + 1, d.begin() + 4);
   EXPECT_EQ(d[1].address.index, kOdConsumerHeartbeatTime);
   EXPECT_EQ(d[1].address.subindex, 1);
   EXPECT_EQ(d[1].size, 4);
@@ -143,7 +148,7 @@ TEST(CanopenSupervision, NoConsumerConfiguredWhenItsTimeIsZero) {
   c.drive_consumer_heartbeat_ms = 0;
   Bench b(c);
   bring_up(b);
-  EXPECT_EQ(downloads(b, 3).size(), 2U) << "0x1017 and 0x6060 only";
+  EXPECT_EQ(downloads(b, 3).size(), 5U) << "0x1017, 0x6060 and the SYNC period's 0x1006 and 0x60C2 (2) only";
   EXPECT_EQ(b.drive.consumer_time_ms(), 0);
 }
 
