@@ -3,10 +3,12 @@
 
 #include <chrono>
 #include <exception>
+#include <memory>
 #include <optional>
 
 #include "ground/command.hpp"
 #include "ground/station.hpp"
+#include "ground/station_keeper.hpp"
 
 namespace tensegrity::hil {
 
@@ -53,15 +55,18 @@ std::string SoakOperator::post(const ScenarioEvent& event) {
 }
 
 void SoakOperator::run(const std::filesystem::path& enclave_dir, int domain) {
-  std::optional<ground::Station> station;
+  ground::StationOptions so;
+  so.domain = domain;
+  so.name = "soak-operator";
+  so.publish_heartbeat = false;  // a bystander, as a console: not the end caps' host
+  so.serve_time = false;
+  so.enclave_dir = enclave_dir;
+  std::unique_ptr<ground::StationKeeper> keeper;
   try {
-    ground::StationOptions so;
-    so.domain = domain;
-    so.name = "soak-operator";
-    so.publish_heartbeat = false;  // a bystander, as a console: not the end caps' host
-    so.serve_time = false;
-    so.enclave_dir = enclave_dir;
-    station.emplace(so);
+    // As the console keeps its station: a handshake stalled with one end cap (heard,
+    // not reached) is healed by a fresh participant beside the first.
+    keeper = std::make_unique<ground::StationKeeper>([so] { return std::make_unique<ground::Station>(so); },
+                                                     ground::StationKeeper::Options{});
   } catch (const std::exception& e) {
     if (sinks_.log) sinks_.log(std::string("operator: no station: ") + e.what());
     return;
@@ -76,9 +81,12 @@ void SoakOperator::run(const std::filesystem::path& enclave_dir, int domain) {
         queue_.pop_front();
       }
     }
+    keeper->tick(ground::Station::now_ns());
+    const std::shared_ptr<ground::Station> station = keeper->current();
     if (next) execute(*station, *next);
     observe(*station);
   }
+  if (sinks_.log) sinks_.log("operator: the station joined again " + std::to_string(keeper->rejoins()) + " time(s)");
 }
 
 void SoakOperator::execute(ground::Station& station, const ScenarioEvent& ev) {
@@ -108,7 +116,7 @@ void SoakOperator::execute(ground::Station& station, const ScenarioEvent& ev) {
   if (sinks_.log) {
     sinks_.log("operator: " + ev.describe() + ": " + std::to_string(accepted) + " of " +
                std::to_string(report.results.size()) + " accepted" +
-               (report.preempted ? " (preempted by an estop)" : ""));
+               (report.preempted ? " (preempted by an estop)" : "") + why);
   }
 }
 
