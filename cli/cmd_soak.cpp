@@ -4,6 +4,7 @@
 // operator's estops, clears and starts, its invariants checked throughout. Exit 1,
 // naming the violations, when one broke.
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -87,7 +88,14 @@ void run_soak_command(const SoakArgs& args) {
   if (!r.ok) {
     std::string names;
     for (const auto& v : r.violations) names += "\n  " + v.describe();
-    throw CommandError(1, "soak: " + std::to_string(r.violations.size()) + " invariant violation(s):" + names);
+    const std::string message = "soak: " + std::to_string(r.violations.size()) + " invariant violation(s):" + names;
+    if (r.operator_hung) {
+      // A thread stuck in Fast DDS: leave without the static destructors that would join it.
+      std::fprintf(stderr, "tensegrity: %s\n", message.c_str());
+      std::fflush(nullptr);
+      std::_Exit(1);
+    }
+    throw CommandError(1, message);
   }
 }
 

@@ -54,7 +54,10 @@ void SoakChecker::estop(double t_s, const std::vector<SoakAck>& acks) {
     ++checked_["estop"];
     const SoakAck a = static_cast<std::size_t>(e) < acks.size() ? acks[static_cast<std::size_t>(e)] : SoakAck{};
     if (!a.acked) {
-      add("estop", t_s, e, "never acknowledged (running, on the link)");
+      add("estop", t_s, e,
+          std::string("never acknowledged (running, on the link); ") + (a.taken   ? "its heartbeat shows the stop taken"
+                                                                        : a.heard ? "its heartbeats show no stop taken"
+                                                                                  : "no heartbeat of it heard"));
       continue;
     }
     estop_latencies_s_.push_back(a.latency_s);

@@ -33,6 +33,10 @@ struct SoakViolation {
 struct SoakAck {
   bool acked = false;
   double latency_s = 0.0;  // from the command's first sending
+  // Not acked: whether the end cap's heartbeats (same life) counted one more estop by
+  // the end of the command, i.e. it took the stop and only its answer was lost.
+  bool taken = false;
+  bool heard = false;  // a heartbeat of it was heard at all
 };
 
 struct RssSample {

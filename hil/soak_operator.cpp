@@ -32,15 +32,27 @@ ground::CommandKind command_of(FaultKind fault) {
 SoakOperator::SoakOperator(int domain, const std::filesystem::path& enclave_dir, int endcap_count,
                            SoakOperatorSinks sinks)
     : endcap_count_(endcap_count), sinks_(std::move(sinks)) {
-  thread_ = std::thread([this, enclave_dir, domain] { run(enclave_dir, domain); });
+  thread_ = std::thread([this, enclave_dir, domain] {
+    run(enclave_dir, domain);
+    const std::lock_guard lock(done_mutex_);
+    done_ = true;
+    done_cv_.notify_all();
+  });
 }
 
-SoakOperator::~SoakOperator() { stop(); }
+SoakOperator::~SoakOperator() { static_cast<void>(stop()); }
 
-void SoakOperator::stop() {
-  stop_ = true;
-  wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
+bool SoakOperator::stop(double timeout_s) {
+  finish();
+  if (!thread_.joinable()) return true;
+  std::unique_lock lock(done_mutex_);
+  if (!done_cv_.wait_for(lock, std::chrono::duration<double>(timeout_s), [this] { return done_; })) {
+    thread_.detach();
+    return false;
+  }
+  lock.unlock();
+  thread_.join();
+  return true;
 }
 
 std::string SoakOperator::post(const ScenarioEvent& event) {
@@ -87,6 +99,7 @@ void SoakOperator::run(const std::filesystem::path& enclave_dir, int domain) {
     observe(*station);
   }
   if (sinks_.log) sinks_.log("operator: the station joined again " + std::to_string(keeper->rejoins()) + " time(s)");
+  keeper.reset();  // the stations deleted here, on this thread (stop() may stop waiting)
 }
 
 void SoakOperator::execute(ground::Station& station, const ScenarioEvent& ev) {
@@ -101,14 +114,21 @@ void SoakOperator::execute(ground::Station& station, const ScenarioEvent& ev) {
     co.keep_going = [this] { return !estop_queued_ && !stop_; };
   }
   const std::int64_t start_ns = kind == ground::CommandKind::start ? ground::Station::now_ns() + kStartLeadNs : 0;
+  const auto before = station.snapshot();
   const ground::CommandReport report = ground::send_command(station, kind, start_ns, co);
+  const auto after = station.snapshot();
   int accepted = 0;
   std::vector<SoakAck> acks(static_cast<std::size_t>(endcap_count_));
   std::map<std::string, std::string> refused;  // reason -> end caps
   for (const auto& r : report.results) {
     accepted += r.accepted ? 1 : 0;
     if (!r.accepted) refused[r.text] += (refused[r.text].empty() ? "" : ",") + std::to_string(r.endcap);
-    if (r.endcap >= 0 && r.endcap < endcap_count_) acks[static_cast<std::size_t>(r.endcap)] = {r.acked, r.latency_s};
+    if (r.endcap < 0 || r.endcap >= endcap_count_) continue;
+    const auto e = static_cast<std::size_t>(r.endcap);
+    const auto& was = before[e].heartbeat;
+    const auto& is = after[e].heartbeat;
+    const bool taken = before[e].seen && is.life_id() == was.life_id() && is.estops_received() > was.estops_received();
+    acks[e] = {r.acked, r.latency_s, taken, after[e].seen};
   }
   if (kind == ground::CommandKind::emergency_stop && sinks_.estop) sinks_.estop(ev.time_s, acks);
   std::string why;

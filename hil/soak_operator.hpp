@@ -49,8 +49,18 @@ class SoakOperator {
   std::string post(const ScenarioEvent& event);
   // The run's physics time, for what the operator observes.
   void set_time(double t_s) { now_s_.store(t_s, std::memory_order_relaxed); }
-  // Ends the thread (a command in flight is finished first).
-  void stop();
+  // Asks the thread to end (a command in flight is finished first) without waiting:
+  // from the stepper's thread before the end caps shut down, so that the station is
+  // deleted while their participants live. Fast DDS 2.9 deadlocked here deleting a
+  // secured station while the end caps' participants were being removed.
+  void finish() {
+    stop_ = true;
+    wake_.notify_all();
+  }
+  // finish(), then waits at most `timeout_s` for the thread; false when it did not end
+  // (its station's deletion hung): the thread is left running, and this object must
+  // then outlive the process (never deleted).
+  bool stop(double timeout_s = 10.0);
 
  private:
   void run(const std::filesystem::path& enclave_dir, int domain);
@@ -64,6 +74,9 @@ class SoakOperator {
   std::deque<ScenarioEvent> queue_;
   std::atomic<bool> estop_queued_{false};
   std::atomic<bool> stop_{false};
+  std::mutex done_mutex_;
+  std::condition_variable done_cv_;
+  bool done_ = false;
   std::atomic<double> now_s_{0.0};
   std::map<int, std::int64_t> last_heartbeat_ns_;
   std::map<std::pair<int, std::uint32_t>, std::int64_t> life_first_ns_;

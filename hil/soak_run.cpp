@@ -27,6 +27,9 @@ sim::Robot robot_of(const SoakOptions& o) {
   return sim::load_robot(o.robot.empty() ? sim::robot_path_for_policy(o.policy) : o.robot);
 }
 
+// The operator ends this long before the run's end, while the end caps still run.
+constexpr double kOperatorEndS = 1.0;
+
 // What the stepper's thread records each step: nothing that can block.
 struct StepWatch {
   std::atomic<double> max_tension_n{0.0};
@@ -98,14 +101,17 @@ SoakResult run_soak(const SoakOptions& options) {
   };
   RssSampler memory;
   StepWatch watch;
+  // On the heap: if its station's deletion hangs, it must outlive the process.
+  auto* op_owner = new SoakOperator(domain, enclave, n, sinks);
   {
-    SoakOperator op(domain, enclave, n, sinks);
+    SoakOperator& op = *op_owner;
     HilOptions h = hil_options(options, result.scenario, domain);
     h.operator_command = [&op](const ScenarioEvent& ev) { return op.post(ev); };
     const double limit_n = bounds.tension_limit_n;
     h.after_step = [&](const WorldStepper& s, ProcessLauncher& launcher) {
       const double t_s = s.stats().sim_time_s();
       op.set_time(t_s);
+      if (t_s >= options.duration_s - kOperatorEndS) op.finish();  // before the end caps shut down
       const double max_n = s.stats().max_tension_n;
       watch.max_tension_n.store(max_n, std::memory_order_relaxed);
       if (max_n > limit_n && watch.first_over_s.load() < 0.0) watch.first_over_s.store(t_s);
@@ -115,14 +121,16 @@ SoakResult run_soak(const SoakOptions& options) {
       }
     };
     result.hil = run_hil(h);
-    op.stop();
   }
+  result.operator_hung = !op_owner->stop();
+  if (!result.operator_hung) delete op_owner;
   const std::lock_guard lock(checked);
   const double over_s = watch.first_over_s.load();
   checker.tension(over_s >= 0.0 ? over_s : options.duration_s, watch.max_tension_n.load());
   for (const EndcapSummary& e : result.hil.endcaps) checker.host_losses(e.endcap, e.host_losses);
   for (const auto& [process, samples] : memory.stop()) checker.memory(process, samples);
   if (!result.hil.ok) checker.run_failed(result.hil.error);
+  if (result.operator_hung) checker.run_failed("the operator's station did not shut down within 10 s (Fast DDS)");
   result.violations = checker.violations();
   result.checks = checker.to_json();
   result.ok = result.hil.ok && result.violations.empty();

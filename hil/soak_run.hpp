@@ -42,6 +42,9 @@ struct SoakResult {
   nlohmann::json checks;  // SoakChecker::to_json()
   HilResult hil;
   std::vector<std::string> operator_log;
+  // Its station's deletion hung: a thread is left running; end the process at once
+  // (std::_Exit) after reporting, as static destructors may hang on it too.
+  bool operator_hung = false;
   double load_average_start = 0.0, load_average_end = 0.0;  // 1-minute
 };
 

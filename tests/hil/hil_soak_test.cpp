@@ -140,6 +140,7 @@ TEST(HilSoakCheck, EachInvariantFailsOnItsBreach) {
   ASSERT_EQ(c.violations().size(), 3u);
   EXPECT_EQ(c.violations()[1].describe(), "estop at 11.000 s, end cap 7: acknowledged after 200.0 ms, bound 50.0 ms");
   EXPECT_EQ(c.violations()[2].endcap, 8);
+  EXPECT_EQ(c.violations()[2].detail, "never acknowledged (running, on the link); no heartbeat of it heard");
   c.table(5.0, 0, 1, "gait", 2, 0.0);
   c.table(5.0, 1, 9, "", 0, 1.0);  // a new life, not yet loaded
   EXPECT_EQ(c.violations().size(), 3u);
