@@ -48,6 +48,8 @@ void add_security_command(CLI::App& app);
 // The HIL emulator (hil/): `hil`, and `bench hil` added by add_bench_command.
 void add_hil_command(CLI::App& app);
 void add_bench_hil_command(CLI::App& bench);
+// `soak`: the HIL's chaos soak (hil/soak_run.hpp); needs the DDS link.
+void add_soak_command(CLI::App& app);
 // The web view (view/).
 void add_view_command(CLI::App& app);
 

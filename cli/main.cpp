@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_console_command(app);
   tensegrity::cli::add_record_command(app);
   tensegrity::cli::add_security_command(app);
+  tensegrity::cli::add_soak_command(app);
 #endif
   tensegrity::cli::add_hil_command(app);
 #ifdef TENSEGRITY_CLI_VIEW

@@ -61,7 +61,7 @@ bool takes_no_params(hil::FaultKind kind) {
 
 void check(const hil::ScenarioEvent& ev) {
   require(std::isfinite(ev.time_s) && ev.time_s >= 0.0);
-  require(ev.endcap == -1 ? hil::is_dds_link_fault(ev.fault) : ev.endcap >= 0 && ev.endcap < kEndcaps);
+  require(ev.endcap == -1 ? hil::may_name_every_endcap(ev.fault) : ev.endcap >= 0 && ev.endcap < kEndcaps);
   require(ev.params.motor >= -1 && ev.params.motor <= 3);
   require(ev.params.probability >= 0.0 && ev.params.probability <= 1.0);
   require(std::isfinite(ev.params.duration_s) && ev.params.duration_s >= 0.0);

@@ -31,6 +31,9 @@ std::string LiveFaultTarget::freeze(int endcap, bool loop_only) { return roster_
 
 std::string LiveFaultTarget::set_dds_link(int endcap, bool up) { return roster_.processes().set_dds_link(endcap, up); }
 std::string LiveFaultTarget::mute_dds(int endcap) { return roster_.processes().mute_dds(endcap); }
+std::string LiveFaultTarget::operator_command(const ScenarioEvent& event) {
+  return operator_ ? operator_(event) : FaultTarget::operator_command(event);
+}
 
 void FaultInjector::apply_due(std::int64_t step, std::int64_t now_ns, FaultTarget& target,
                               std::vector<std::string>& log) {
@@ -69,6 +72,14 @@ void FaultInjector::apply(const ScenarioEvent& ev, std::int64_t step, std::int64
     case FaultKind::hang_loop:
     case FaultKind::stop_endcap:
       if (const std::string why = target.freeze(e, ev.fault == FaultKind::hang_loop); !why.empty()) {
+        log.push_back(ev.describe() + ": not done: " + why);
+        return;
+      }
+      break;
+    case FaultKind::estop:
+    case FaultKind::clear_fault:
+    case FaultKind::start:
+      if (const std::string why = target.operator_command(ev); !why.empty()) {
         log.push_back(ev.describe() + ": not done: " + why);
         return;
       }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,16 @@ class FaultTarget {
   // SIGSTOP the program (loop_only: hang its control loop alone); the barrier no
   // longer waits for it. "" when done, else why not.
   virtual std::string freeze(int endcap, bool loop_only) = 0;
+  // An operator's command (estop, clear_fault, start), handed to the run's operator,
+  // which sends it over DDS off the stepper's thread. "" when handed over, else why not.
+  virtual std::string operator_command(const ScenarioEvent& event) {
+    static_cast<void>(event);
+    return "no operator in this run";
+  }
 };
+
+// Takes an operator's command without blocking (HilOptions::operator_command).
+using OperatorCommand = std::function<std::string(const ScenarioEvent&)>;
 
 // The real thing: the roster's devices and programs, the hub's wire.
 class LiveFaultTarget final : public FaultTarget {
@@ -54,10 +64,13 @@ class LiveFaultTarget final : public FaultTarget {
   std::string set_dds_link(int endcap, bool up) override;
   std::string mute_dds(int endcap) override;
   std::string freeze(int endcap, bool loop_only) override;
+  std::string operator_command(const ScenarioEvent& event) override;
+  void set_operator(OperatorCommand command) { operator_ = std::move(command); }
 
  private:
   EndcapRoster& roster_;
   UdpHub& hub_;
+  OperatorCommand operator_;
 };
 
 class FaultInjector {

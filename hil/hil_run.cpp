@@ -203,6 +203,7 @@ void assemble(const HilOptions& options, RunParts& parts) {
       std::make_unique<WorldStepper>(robot, sim::settled_state(robot, robot.time_step_s), *parts.hub, *parts.launcher,
                                      stepper_config(options, parts, lc.spool), parts.clock, options.stop);
   parts.stepper->set_scenario(options.scenario);
+  if (options.operator_command) parts.stepper->set_operator(options.operator_command);
   if (!options.record_csv.empty()) {
     parts.recorder = std::make_unique<Recorder>(options.record_csv, parts.stepper->model());
     parts.stepper->set_recorder(parts.recorder.get());

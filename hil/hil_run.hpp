@@ -66,6 +66,10 @@ struct HilOptions {
   // Tests: called once the end caps are running, before boot (e.g. to SIGSTOP one).
   std::function<void(ProcessLauncher&)> after_launch;
   std::function<void(const WorldStepper&, ProcessLauncher&)> after_step;
+  // The scenario's operator commands (estop, clear_fault, start) go here, on the
+  // stepper's thread: it must not block (tensegrity soak's operator queues them).
+  // Unset: such an event is logged as not done.
+  OperatorCommand operator_command;
   // Tests: called before each attempt (1, 2, ...) with that attempt's options.
   std::function<void(int attempt, HilOptions&)> before_attempt;
   // A stop requested here (Ctrl-C in the launcher) ends the run in order with

@@ -16,7 +16,7 @@ namespace tensegrity::hil {
 
 namespace {
 
-constexpr std::array<std::pair<FaultKind, const char*>, 19> kNames{{
+constexpr std::array<std::pair<FaultKind, const char*>, 22> kNames{{
     {FaultKind::drive_fault, "drive_fault"},
     {FaultKind::drive_silent, "drive_silent"},
     {FaultKind::load_cell_stuck, "load_cell_stuck"},
@@ -36,6 +36,9 @@ constexpr std::array<std::pair<FaultKind, const char*>, 19> kNames{{
     {FaultKind::hang_loop, "hang_loop"},
     {FaultKind::stop_endcap, "stop_endcap"},
     {FaultKind::mute_dds, "mute_dds"},
+    {FaultKind::estop, "estop"},
+    {FaultKind::clear_fault, "clear_fault"},
+    {FaultKind::start, "start"},
 }};
 
 FaultKind fault_from_name(const std::string& name, const std::string& where) {
@@ -141,6 +144,12 @@ bool is_dds_link_fault(FaultKind kind) {
   return kind == FaultKind::cut_dds || kind == FaultKind::restore_dds || kind == FaultKind::mute_dds;
 }
 
+bool is_operator_command(FaultKind kind) {
+  return kind == FaultKind::estop || kind == FaultKind::clear_fault || kind == FaultKind::start;
+}
+
+bool may_name_every_endcap(FaultKind kind) { return is_dds_link_fault(kind) || is_operator_command(kind); }
+
 std::string ScenarioEvent::describe() const {
   std::ostringstream s;
   s << "t=" << time_s << " s " << (endcap < 0 ? std::string("all end caps") : "end cap " + std::to_string(endcap))
@@ -204,7 +213,7 @@ Scenario parse_scenario(const std::string& text, int endcap_count, const std::st
     ev.time_s = e["time_s"].get<double>();
     if (!e.contains("fault") || !e["fault"].is_string()) throw HilError(where + ".fault: a string is required");
     ev.fault = fault_from_name(e["fault"].get<std::string>(), where + ".fault");
-    const bool needs_endcap = !is_dds_link_fault(ev.fault);
+    const bool needs_endcap = !may_name_every_endcap(ev.fault);
     if (e.contains("endcap")) {
       const auto& endcap = e["endcap"];
       if (!endcap.is_number_integer()) throw HilError(where + ".endcap: an integer");
@@ -229,7 +238,7 @@ void check_scenario(const Scenario& scenario, const sim::Robot& robot) {
   for (std::size_t i = 0; i < scenario.events.size(); ++i) {
     const ScenarioEvent& ev = scenario.events[i];
     const std::string where = "scenario event " + std::to_string(i) + " (" + ev.describe() + ")";
-    if (ev.endcap >= robot.endcap_count() || (ev.endcap < 0 && !is_dds_link_fault(ev.fault))) {
+    if (ev.endcap >= robot.endcap_count() || (ev.endcap < 0 && !may_name_every_endcap(ev.fault))) {
       throw HilError(where + ": the robot has end caps 0.." + std::to_string(robot.endcap_count() - 1));
     }
     const auto params = params_of(ev.fault);
@@ -279,7 +288,7 @@ ScenarioEvent parse_fault_option(const std::string& text, int endcap_count) {
   }
   ScenarioEvent ev;
   ev.fault = fault_from_name(text.substr(colon + 1, at - colon - 1), "--fault '" + text + "'");
-  const bool all_allowed = is_dds_link_fault(ev.fault);
+  const bool all_allowed = may_name_every_endcap(ev.fault);
   const std::string who = text.substr(0, colon);
   try {
     std::size_t used = 0;

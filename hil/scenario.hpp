@@ -41,11 +41,20 @@ enum class FaultKind : std::uint8_t {
   stop_endcap,  // SIGSTOP: a dead end cap; its drives find out through their heartbeat consumer
   mute_dds,     // the end cap's DDS participant stops sending, for good, and still hears (a handshake
                 // stalled one way); its rejoin clears it; no endcap: all
+  // An operator's commands over DDS (the run's operator, HilOptions::operator_command),
+  // acknowledged per end cap: no endcap: every end cap.
+  estop,
+  clear_fault,
+  start,
 };
 
 const char* to_string(FaultKind kind);
 // cut_dds, restore_dds, mute_dds: faults of the DDS link, which may name every end cap.
 bool is_dds_link_fault(FaultKind kind);
+// estop, clear_fault, start: an operator's commands, which may name every end cap.
+bool is_operator_command(FaultKind kind);
+// Either of the two: an event that may name every end cap (endcap -1).
+bool may_name_every_endcap(FaultKind kind);
 
 struct FaultParams {
   int motor = 0;                // -1: every motor of the end cap
@@ -76,7 +85,7 @@ struct Scenario {
 Scenario parse_scenario(const std::string& json_text, int endcap_count, const std::string& source = "scenario");
 Scenario load_scenario(const std::filesystem::path& path, int endcap_count);
 // "ENDCAP:FAULT@TIME_S" (params default), e.g. "3:drive_fault@2.0"; ENDCAP "all"
-// for the DDS link faults.
+// for the DDS link faults and the operator's commands.
 ScenarioEvent parse_fault_option(const std::string& text, int endcap_count);
 void sort_events(Scenario& scenario);
 // What the parser cannot know: every end cap named is one of the robot's, and every

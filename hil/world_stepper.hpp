@@ -122,6 +122,7 @@ class WorldStepper final : private TickAnswers {
 
   void set_scenario(const Scenario& scenario) { faults_ = FaultInjector(scenario, stats_.dt_s); }
   void set_recorder(Recorder* recorder) { recorder_ = recorder; }
+  void set_operator(OperatorCommand command) { fault_target_.set_operator(std::move(command)); }
   // Called after each physics step (tests, progress).
   void set_step_hook(std::function<void(const WorldStepper&)> hook) { hook_ = std::move(hook); }
 

@@ -42,6 +42,10 @@ class RecordingTarget final : public FaultTarget {
     actions.push_back(std::string(loop_only ? "hang " : "stop ") + std::to_string(e));
     return "";
   }
+  std::string operator_command(const ScenarioEvent& e) override {
+    actions.push_back(std::string(to_string(e.fault)) + " " + std::to_string(e.endcap));
+    return e.fault == FaultKind::start ? "busy" : "";
+  }
   std::vector<std::string> actions;
 
  private:
@@ -128,6 +132,25 @@ TEST(HilFaultInjector, AMuteReachesTheNamedEndcapOrEveryOne) {
   EXPECT_EQ(by_step[1].second, (std::vector<std::string>{"mute 0", "mute 1", "mute 2"}));
   ASSERT_EQ(log.size(), 2u);
   EXPECT_NE(log[0].find("mute_dds"), std::string::npos) << log[0];
+}
+
+// The operator's commands go to the target as one event each (every end cap or one);
+// one it cannot take is logged as not done.
+TEST(HilFaultInjector, OperatorCommandsAreHandedOverWhenDue) {
+  Scenario s;
+  s.events = {event(0.001, -1, FaultKind::estop), event(0.003, 2, FaultKind::clear_fault),
+              event(0.003, -1, FaultKind::start)};
+  FaultInjector injector(s, kDtS);
+  RecordingTarget target;
+  std::vector<std::string> log;
+  const auto by_step = run(injector, target, 4, log);
+  ASSERT_EQ(by_step.size(), 2u);
+  EXPECT_EQ(by_step[0].first, 1);
+  EXPECT_EQ(by_step[0].second, (std::vector<std::string>{"estop -1"}));
+  EXPECT_EQ(by_step[1].second, (std::vector<std::string>{"clear_fault 2", "start -1"}));
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[0], "t=0.001 s all end caps: estop");
+  EXPECT_NE(log[2].find("start: not done: busy"), std::string::npos) << log[2];
 }
 
 TEST(HilFaultInjector, DeviceFaultsReachTheChosenMotors) {

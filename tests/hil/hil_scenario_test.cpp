@@ -127,6 +127,27 @@ TEST(HilScenario, SupervisionFaults) {
   EXPECT_THROW(parse_scenario(R"([{"time_s": 1, "fault": "hang_loop"}])", 12), HilError) << "needs an end cap";
 }
 
+// An operator's commands: every end cap unless one is named; they take no parameters.
+TEST(HilScenario, OperatorCommands) {
+  const Scenario s = parse_scenario(R"([{"time_s": 3, "fault": "start"}, {"time_s": 1, "fault": "estop"},
+      {"time_s": 2, "endcap": 5, "fault": "clear_fault"}])",
+                                    12);
+  ASSERT_EQ(s.events.size(), 3u);
+  EXPECT_EQ(s.events[0].fault, FaultKind::estop);
+  EXPECT_EQ(s.events[0].endcap, -1);
+  EXPECT_EQ(s.events[1].fault, FaultKind::clear_fault);
+  EXPECT_EQ(s.events[1].endcap, 5);
+  EXPECT_EQ(s.events[2].fault, FaultKind::start);
+  EXPECT_EQ(parse_fault_option("all:estop@4", 12).endcap, -1);
+  EXPECT_EQ(parse_fault_option("2:start@4", 12).fault, FaultKind::start);
+  EXPECT_TRUE(is_operator_command(FaultKind::clear_fault));
+  EXPECT_FALSE(is_operator_command(FaultKind::cut_dds));
+  EXPECT_THROW(parse_scenario(R"([{"time_s": 1, "fault": "estop", "params": {"motor": 0}}])", 12), HilError);
+  Scenario all;
+  all.events = {parse_fault_option("all:estop@1", 12)};
+  EXPECT_NO_THROW(check_scenario(all, sim::load_robot(sim::robot_path_named("superball"))));
+}
+
 // The parser takes motors -1..3 and end caps below the count it is given; the robot
 // decides the rest before the run starts, not 30 s into it.
 TEST(HilScenario, EventsAreCheckedAgainstTheRobotBeforeTheRun) {
