@@ -97,10 +97,12 @@ nlohmann::json outcome_json(const DriveOutcome& o, const DriveArgs& args, const 
   int reached = 0;
   for (const auto& w : o.waypoints) {
     reached += w.reached ? 1 : 0;
+    // A waypoint the steering never got to has no closest approach: null.
+    const bool steered = w.miss_m < 1e299;
     wps.push_back({{"to", {w.target_m.x(), w.target_m.y()}},
                    {"reached", w.reached},
-                   {"time_s", w.time_s},
-                   {"miss_m", w.miss_m}});
+                   {"time_s", steered ? nlohmann::json(w.time_s) : nlohmann::json()},
+                   {"miss_m", steered ? nlohmann::json(w.miss_m) : nlohmann::json()}});
   }
   return {{"robot", robot.name},
           {"seed", args.seed},
@@ -147,6 +149,10 @@ void run_drive(const DriveArgs& args) {
   } else {
     for (std::size_t i = 0; i < n; ++i) {
       const auto& w = o.waypoints[i];
+      if (w.miss_m >= 1e299) {
+        std::printf("waypoint %zu (%+.2f, %+.2f): not steered to\n", i + 1, w.target_m.x(), w.target_m.y());
+        continue;
+      }
       std::printf("waypoint %zu (%+.2f, %+.2f): %s, closest %.2f m at %.1f s\n", i + 1, w.target_m.x(), w.target_m.y(),
                   w.reached ? "reached" : "missed", w.miss_m, w.time_s);
     }

@@ -83,10 +83,11 @@ def report(results, headings, seeds, no_square):
         print("|---|---|---|---|---|---|")
         for s in seeds:
             r = results[("square", 0, s)]
-            worst = max(w["miss_m"] for w in r["waypoints"])
+            misses = [w["miss_m"] for w in r["waypoints"]]
+            worst = "never steered to the last" if None in misses else f"{max(misses):.2f}"
             faults += r["faults"]
             hard += r["hard_limit_steps"]
-            print(f"| {s} | {r['reached']}/{len(r['waypoints'])} | {r['time_s']:.1f} | {worst:.2f} | {r['switches']} | "
+            print(f"| {s} | {r['reached']}/{len(r['waypoints'])} | {r['time_s']:.1f} | {worst} | {r['switches']} | "
                   f"{r['cutoff_steps']} ({r['cutoff_steps_after_switch']}) |")
     print(f"\nend caps faulted: {faults}; steps with a cable above the hard limit: {hard}")
 

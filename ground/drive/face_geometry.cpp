@@ -7,20 +7,6 @@
 #include <cmath>
 
 namespace tensegrity::drive {
-namespace {
-
-// The yaw left when the description, turned so `from` faces down, is tipped so `to`
-// faces down, read against `to`'s own face-down turn (as start_frame reads a pose).
-double tip_yaw(const sim::HullFace& from, const sim::HullFace& to) {
-  const Eigen::Matrix3d r_from = sim::face_down_turn(from.normal);
-  const Eigen::Matrix3d tip =
-      Eigen::Quaterniond::FromTwoVectors(r_from * to.normal, -Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Matrix3d yaw = tip * r_from * sim::face_down_turn(to.normal).transpose();
-  return std::atan2(yaw(1, 0), yaw(0, 0));
-}
-
-}  // namespace
-
 FaceGeometry::FaceGeometry(const sim::Robot& robot) : faces_(sim::hull_faces(robot)) {
   const int n = robot.node_count();
   axis_.assign(n, Eigen::Vector3d::UnitZ());
@@ -35,13 +21,6 @@ FaceGeometry::FaceGeometry(const sim::Robot& robot) : faces_(sim::hull_faces(rob
   const Eigen::Matrix3d normal = u.transpose() * u;
   fit_ = normal.fullPivLu().isInvertible() ? Eigen::Matrix<double, 3, Eigen::Dynamic>(normal.inverse() * u.transpose())
                                            : Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, n);
-  const std::size_t f = faces_.size();
-  turn_rad_.assign(f * f, 0.0);
-  for (std::size_t a = 0; a < f; ++a) {
-    for (std::size_t b = 0; b < f; ++b) {
-      if (a != b) turn_rad_[a * f + b] = tip_yaw(faces_[a], faces_[b]);
-    }
-  }
 }
 
 int FaceGeometry::face_index(std::array<int, 3> nodes) const {

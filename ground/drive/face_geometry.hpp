@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// What the end caps' accelerometers say about the robot's pose, and how its start
-// frame (robot/start_frame.hpp) turns as it rolls from face to face. Only the rest
+// What the end caps' accelerometers say about the robot's pose: the direction that
+// points down and the hull face it stands on. Only the rest
 // geometry of the robot file is used: no physics, so the same code serves the
 // in-process model, the HIL and a robot.
 //
@@ -38,16 +38,10 @@ class FaceGeometry {
   // The face whose outward normal is nearest `down` (description frame).
   int nearest_face(const Eigen::Vector3d& down) const;
 
-  // How the start frame turns (about the vertical, radians, counter-clockwise) when
-  // the robot tips from face `from` onto face `to` about the shortest axis, as a rigid
-  // body rolls over the edge two adjacent faces share.
-  double turn_rad(int from, int to) const { return turn_rad_[static_cast<std::size_t>(from) * faces_.size() + to]; }
-
  private:
   std::vector<sim::HullFace> faces_;
   std::vector<Eigen::Vector3d> axis_;  // per end cap: outward along its strut, description frame
   Eigen::Matrix<double, 3, Eigen::Dynamic> fit_;  // least-squares solution for `down`
-  std::vector<double> turn_rad_;                   // faces x faces
 };
 
 }  // namespace tensegrity::drive

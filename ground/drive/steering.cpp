@@ -6,6 +6,10 @@
 
 namespace tensegrity::drive {
 
+namespace {
+constexpr double kReachMargin = 0.75;
+}  // namespace
+
 double wrap_rad(double rad) {
   double w = std::fmod(rad, 2.0 * std::numbers::pi);
   if (w > std::numbers::pi) w -= 2.0 * std::numbers::pi;
@@ -44,38 +48,25 @@ Choice Steering::choose(double time_s, Estimator& estimator) {
   Choice c;
   c.gait = gait_;
   if (done() || !now.located || now.face < 0) return c;
-  correct_yaw(now, estimator);
-  now = estimator.estimate(time_s);
+  if (gait_ >= 0) {
+    ++periods_;
+    // The first period's transient is not the gait's heading: measure from its end.
+    if (periods_ == 1) segment_start_m_ = now.position_m;
+    if (periods_ >= 2) correct_yaw(now, estimator);
+    now = estimator.estimate(time_s);
+  }
   const Eigen::Vector2d to = waypoints_[active_] - now.position_m;
   c.bearing_rad = std::atan2(to.y(), to.x());
   // Staying: the way the current gait has gone, else what was expected of it.
   double keep_error = 1e300;
   if (gait_ >= 0) {
-    ++periods_;
-    // The first period's transient is not the gait's heading: measure from its end.
-    if (periods_ == 1) segment_start_m_ = now.position_m;
     c.expected_heading_rad = measured_heading(now).value_or(segment_expected_rad_);
     keep_error = std::abs(wrap_rad(c.expected_heading_rad - c.bearing_rad));
     if (periods_ < config_.hold_periods || keep_error <= config_.keep_within_deg * std::numbers::pi / 180.0) {
       return c;
     }
   }
-  // A face the set has no gait for keeps the current gait (or, at the start, tries them all).
-  std::vector<int> candidates = by_face_[now.face];
-  if (candidates.empty() && gait_ < 0) {
-    for (std::size_t g = 0; g < set_.gaits.size(); ++g) candidates.push_back(static_cast<int>(g));
-  }
-  int best = -1;
-  double best_error = 1e300, best_heading = 0.0;
-  for (int g : candidates) {
-    const double heading = wrap_rad(now.yaw_rad + heading_rad_[g]);
-    const double error = std::abs(wrap_rad(heading - c.bearing_rad));
-    if (error < best_error) {
-      best = g;
-      best_error = error;
-      best_heading = heading;
-    }
-  }
+  const auto [best, best_error, best_heading] = best_candidate(now, c.bearing_rad);
   const double margin = config_.switch_margin_deg * std::numbers::pi / 180.0;
   if (best < 0 || best == gait_ || (gait_ >= 0 && best_error + margin >= keep_error)) return c;
   gait_ = best;
@@ -89,11 +80,28 @@ Choice Steering::choose(double time_s, Estimator& estimator) {
   return c;
 }
 
+Steering::Candidate Steering::best_candidate(const Estimate& now, double bearing_rad) const {
+  // A face the set has no gait for keeps the current gait (or, at the start, tries them all).
+  std::vector<int> candidates = by_face_[now.face];
+  if (candidates.empty() && gait_ < 0) {
+    for (std::size_t g = 0; g < set_.gaits.size(); ++g) candidates.push_back(static_cast<int>(g));
+  }
+  Candidate best{-1, 1e300, 0.0};
+  for (int g : candidates) {
+    const double heading = wrap_rad(now.yaw_rad + heading_rad_[g]);
+    const double error = std::abs(wrap_rad(heading - bearing_rad));
+    if (error < best.error_rad) best = {g, error, heading};
+  }
+  return best;
+}
+
 void Steering::update(const Estimate& estimate) {
   if (done() || !estimate.located) return;
   const double d = (waypoints_[active_] - estimate.position_m).norm();
-  const bool passed = best_distance_m_ <= config_.within_m && d > best_distance_m_ + 0.2;
-  if (d <= config_.within_m * 0.8 || passed) {
+  // Inside a margin for the fixes' noise: an estimate 0.1-0.3 m off must not take a
+  // waypoint passed 1.6 m wide for one reached.
+  const bool passed = best_distance_m_ <= kReachMargin * config_.within_m && d > best_distance_m_ + 0.2;
+  if (d <= kReachMargin * config_.within_m || passed) {
     ++active_;
     best_distance_m_ = 1e300;
     return;

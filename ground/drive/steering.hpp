@@ -33,7 +33,7 @@ struct SteeringConfig {
   // and its heading is measured from the end of its first period.
   int hold_periods = 2;
   // The gait being played is kept while its measured heading is this near the bearing.
-  double keep_within_deg = 35.0;
+  double keep_within_deg = 50.0;
 };
 
 struct Choice {
@@ -66,6 +66,13 @@ class Steering {
   // The heading the current gait has shown since it was chosen, when it has gone far enough.
   std::optional<double> measured_heading(const Estimate& now) const;
   void correct_yaw(const Estimate& now, Estimator& estimator);
+  struct Candidate {
+    int gait;
+    double error_rad;    // from the bearing
+    double heading_rad;  // world, expected
+  };
+  // The gait of the set for the estimate's face that points nearest `bearing_rad`.
+  Candidate best_candidate(const Estimate& now, double bearing_rad) const;
 
   const sim::GaitSet& set_;
   std::vector<Eigen::Vector2d> waypoints_;
