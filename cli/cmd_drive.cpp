@@ -48,7 +48,8 @@ Eigen::Vector2d parse_waypoint(const std::string& text, std::size_t index) {
       used = 0;
     }
     if (used == 0 || used != part.size() || !std::isfinite(w[k]) || std::abs(w[k]) > 1e4) {
-      throw CommandError(2, "drive: " + field + ": " + (k == 0 ? "X" : "Y") + " is not a number of metres within 10 km");
+      throw CommandError(2,
+                         "drive: " + field + ": " + (k == 0 ? "X" : "Y") + " is not a number of metres within 10 km");
     }
   }
   return w;
@@ -156,11 +157,12 @@ void run_drive(const DriveArgs& args) {
       std::printf("waypoint %zu (%+.2f, %+.2f): %s, closest %.2f m at %.1f s\n", i + 1, w.target_m.x(), w.target_m.y(),
                   w.reached ? "reached" : "missed", w.miss_m, w.time_s);
     }
-    std::printf("%s after %.1f s of physics: %d switches, %ld cut-off steps (%ld in a period after a switch), %d "
-                "faults, %d steps above the hard limit%s%s\n",
-                o.completed ? "course done" : "course not done", o.time_s, o.switches, o.cutoff_steps,
-                o.cutoff_steps_after_switch, o.faults, o.hard_limit_steps, o.stopped_by.empty() ? "" : "; stopped: ",
-                o.stopped_by.c_str());
+    std::printf(
+        "%s after %.1f s of physics: %d switches, %ld cut-off steps (%ld in a period after a switch), %d "
+        "faults, %d steps above the hard limit%s%s\n",
+        o.completed ? "course done" : "course not done", o.time_s, o.switches, o.cutoff_steps,
+        o.cutoff_steps_after_switch, o.faults, o.hard_limit_steps,
+        o.stopped_by.empty() ? "" : "; stopped: ", o.stopped_by.c_str());
   }
   bool all = o.completed;
   for (const auto& w : o.waypoints) all = all && w.reached;

@@ -229,11 +229,11 @@ class Run {
       const auto e = estimator_->estimate(now);
       const auto nodes = model_.node_positions();
       const sim::StartFrame truth = sim::start_frame(robot_, geometry_.faces(), nodes);
-      record_ << now << ',' << here.x() << ',' << here.y() << ',' << e.position_m.x() << ',' << e.position_m.y()
-              << ',' << face_name(geometry_.faces()[truth.face]) << ','
-              << (e.face >= 0 ? face_name(geometry_.faces()[e.face]) : "") << ',' << truth.yaw_rad * 180.0 / M_PI
-              << ',' << e.yaw_rad * 180.0 / M_PI << ",\"" << (gait_ >= 0 ? set_.gaits[gait_].name : "") << "\","
-              << active << '\n';
+      record_ << now << ',' << here.x() << ',' << here.y() << ',' << e.position_m.x() << ',' << e.position_m.y() << ','
+              << face_name(geometry_.faces()[truth.face]) << ','
+              << (e.face >= 0 ? face_name(geometry_.faces()[e.face]) : "") << ',' << truth.yaw_rad * 180.0 / M_PI << ','
+              << e.yaw_rad * 180.0 / M_PI << ",\"" << (gait_ >= 0 ? set_.gaits[gait_].name : "") << "\"," << active
+              << '\n';
     }
   }
 

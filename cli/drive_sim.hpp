@@ -39,7 +39,7 @@ struct WaypointOutcome {
 
 struct DriveOutcome {
   std::vector<WaypointOutcome> waypoints;
-  double time_s = 0.0;  // physics
+  double time_s = 0.0;     // physics
   bool completed = false;  // the steering reached every waypoint within the time limit
   int periods = 0;
   int switches = 0;

@@ -28,8 +28,8 @@ void Estimator::add_accelerations(double time_s, std::span<const Eigen::Vector3d
     down_ = ((1.0 - config_.down_smoothing) * *down_ + config_.down_smoothing * *down).normalized();
   }
   // Tip the attitude so the measured down points down, without turning about the vertical.
-  attitude_ = Eigen::Quaterniond::FromTwoVectors(attitude_ * *down_, -Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-              attitude_;
+  attitude_ =
+      Eigen::Quaterniond::FromTwoVectors(attitude_ * *down_, -Eigen::Vector3d::UnitZ()).toRotationMatrix() * attitude_;
   const int face = geometry_.nearest_face(*down_);
   if (face != candidate_) {
     candidate_ = face;

@@ -40,7 +40,7 @@ class FaceGeometry {
 
  private:
   std::vector<sim::HullFace> faces_;
-  std::vector<Eigen::Vector3d> axis_;  // per end cap: outward along its strut, description frame
+  std::vector<Eigen::Vector3d> axis_;             // per end cap: outward along its strut, description frame
   Eigen::Matrix<double, 3, Eigen::Dynamic> fit_;  // least-squares solution for `down`
 };
 

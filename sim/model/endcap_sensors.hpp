@@ -36,8 +36,8 @@ class EndcapSensors {
   Eigen::Vector2d fix(const Model& model);
 
  private:
-  std::vector<int> other_end_;  // per end cap: the end cap at its strut's other end
-  std::vector<int> strut_;      // per end cap: its strut
+  std::vector<int> other_end_;   // per end cap: the end cap at its strut's other end
+  std::vector<int> strut_;       // per end cap: its strut
   std::vector<bool> first_end_;  // per end cap: node_a of its strut
   SensorNoise noise_;
   std::mt19937_64 random_;

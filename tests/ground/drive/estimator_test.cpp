@@ -70,7 +70,8 @@ TEST_F(EstimatorTest, FollowsTheFaceAndTheYawThroughARoll) {
     int next = -1;
     for (std::size_t b = 0; b < faces.size() && next < 0; ++b) {
       int shared = 0;
-      for (int i : faces[face].nodes) shared += static_cast<int>(std::count(faces[b].nodes.begin(), faces[b].nodes.end(), i));
+      for (int i : faces[face].nodes)
+        shared += static_cast<int>(std::count(faces[b].nodes.begin(), faces[b].nodes.end(), i));
       if (shared == 2 && static_cast<int>(b) != previous) next = static_cast<int>(b);
     }
     const Eigen::Matrix3d before = pose(faces, face, yaw);

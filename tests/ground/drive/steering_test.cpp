@@ -36,7 +36,8 @@ class SteeringTest : public ::testing::Test {
   // The estimator as it stands at rest on `face` at `yaw_rad`, at `at_m`.
   void stand(Estimator& estimator, double t, const Eigen::Vector2d& at_m, double yaw_rad) {
     for (int k = 0; k < 10; ++k) {
-      estimator.add_accelerations(t - 0.5 + 0.05 * k, testing::readings(robot, testing::pose(geometry.faces(), face, yaw_rad), 0.3, random));
+      estimator.add_accelerations(
+          t - 0.5 + 0.05 * k, testing::readings(robot, testing::pose(geometry.faces(), face, yaw_rad), 0.3, random));
     }
     estimator.add_fix(t - 1.0, at_m);
     estimator.add_fix(t, at_m);
