@@ -10,6 +10,7 @@
 - no end cap faulted and no cable above the hard limit; cut-off steps counted.
 
   tools/drive_targets.py [--tensegrity BIN] [--seeds 1,2,3] [--jobs 2] [--headings 0,30,...] [--no-square]
+                          [--gaits SET]
 """
 import argparse
 import concurrent.futures
@@ -21,8 +22,10 @@ import sys
 from tensegrity_tools import program
 
 
-def drive(binary, waypoints, seed, time_limit):
+def drive(binary, waypoints, seed, time_limit, gaits):
     cmd = [binary, "drive", "--sim", "--json", "--seed", str(seed), "--time-limit", str(time_limit)]
+    if gaits:
+        cmd += ["--gaits", gaits]
     for x, y in waypoints:
         cmd += ["--to", f"{x:.3f},{y:.3f}"]
     # Exit 1 is a course not completed: its JSON still says how far it got.
@@ -39,6 +42,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--headings", default=",".join(str(h) for h in range(0, 360, 30)))
     parser.add_argument("--no-square", action="store_true")
+    parser.add_argument("--gaits", help="gait set file passed to drive (default: drive's own)")
     args = parser.parse_args()
     binary = program.find(args.tensegrity)
     seeds = [int(s) for s in args.seeds.split(",")]
@@ -48,11 +52,11 @@ def main():
         for h in headings:
             goal = (20.0 * math.cos(math.radians(h)), 20.0 * math.sin(math.radians(h)))
             for s in seeds:
-                jobs[("goal", h, s)] = pool.submit(drive, binary, [goal], s, 90)
+                jobs[("goal", h, s)] = pool.submit(drive, binary, [goal], s, 90, args.gaits)
         if not args.no_square:
             square = [(10, 0), (10, 10), (0, 10), (0, 0)]
             for s in seeds:
-                jobs[("square", 0, s)] = pool.submit(drive, binary, square, s, 240)
+                jobs[("square", 0, s)] = pool.submit(drive, binary, square, s, 240, args.gaits)
         results = {k: f.result() for k, f in jobs.items()}
     report(results, headings, seeds, args.no_square)
 

@@ -13,24 +13,29 @@ void Estimator::correct_yaw(double rad) {
 }
 
 void Estimator::add_accelerations(double time_s, std::span<const Eigen::Vector3d> readings) {
-  const auto down = geometry_.down(readings);
+  readings_.push_back({time_s, {readings.begin(), readings.end()}});
+  while (readings_.size() > 1 && readings_.front().time_s < time_s - config_.average_s) readings_.pop_front();
+  std::vector<Eigen::Vector3d> mean(readings.size(), Eigen::Vector3d::Zero());
+  for (const Reading& r : readings_) {
+    for (std::size_t i = 0; i < mean.size() && i < r.m_per_s2.size(); ++i) {
+      mean[i] += r.m_per_s2[i] / static_cast<double>(readings_.size());
+    }
+  }
+  const auto down = geometry_.down(mean);
   if (!down) {
     candidate_ = -1;
     return;
   }
-  if (!down_) {
+  if (!started_) {
     // The first reading: the robot at rest on its face, turned by the given yaw.
-    down_ = down;
-    const int f = geometry_.nearest_face(*down);
+    started_ = true;
     attitude_ = Eigen::AngleAxisd(initial_yaw_rad_, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
-                sim::face_down_turn(geometry_.faces()[f].normal);
-  } else {
-    down_ = ((1.0 - config_.down_smoothing) * *down_ + config_.down_smoothing * *down).normalized();
+                sim::face_down_turn(geometry_.faces()[geometry_.nearest_face(*down)].normal);
   }
   // Tip the attitude so the measured down points down, without turning about the vertical.
   attitude_ =
-      Eigen::Quaterniond::FromTwoVectors(attitude_ * *down_, -Eigen::Vector3d::UnitZ()).toRotationMatrix() * attitude_;
-  const int face = geometry_.nearest_face(*down_);
+      Eigen::Quaterniond::FromTwoVectors(attitude_ * *down, -Eigen::Vector3d::UnitZ()).toRotationMatrix() * attitude_;
+  const int face = geometry_.nearest_face(*down);
   if (face != candidate_) {
     candidate_ = face;
     candidate_since_s_ = time_s;

@@ -17,6 +17,7 @@
 #include <deque>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "ground/drive/face_geometry.hpp"
 
@@ -24,7 +25,9 @@ namespace tensegrity::drive {
 
 struct EstimatorConfig {
   double face_hold_s = 0.3;
-  double down_smoothing = 0.5;  // weight of each new reading in the smoothed down direction
+  // Readings are averaged over this long: a rolling robot's end caps accelerate by
+  // several m/s^2 as it tips and lands, but over half a second that mostly cancels.
+  double average_s = 0.5;
   double fix_window_s = 3.0;
   double initial_yaw_rad = 0.0;
 };
@@ -58,7 +61,12 @@ class Estimator {
   int candidate_ = -1;
   double candidate_since_s_ = 0.0;
   double initial_yaw_rad_;
-  std::optional<Eigen::Vector3d> down_;                     // smoothed, description frame
+  struct Reading {
+    double time_s;
+    std::vector<Eigen::Vector3d> m_per_s2;
+  };
+  std::deque<Reading> readings_;  // the last average_s
+  bool started_ = false;
   Eigen::Matrix3d attitude_ = Eigen::Matrix3d::Identity();  // description -> world
   int face_changes_ = 0;
   struct Fix {

@@ -36,12 +36,12 @@ std::optional<Eigen::Vector3d> FaceGeometry::down(std::span<const Eigen::Vector3
   Eigen::VectorXd axial(readings.size());
   for (std::size_t i = 0; i < readings.size(); ++i) axial[static_cast<Eigen::Index>(i)] = readings[i].z();
   // A robot at rest feels gravity alone: each end cap reads g in all, and the fit is
-  // a unit vector. Tipping, falling or hitting the ground it feels more or less; the
-  // reading then tells its motion as much as its pose, and is left out.
+  // a unit vector. Falling or hitting the ground it feels far more or less; the
+  // reading then tells its motion more than its pose, and is left out.
   double magnitude = 0.0;
   for (const auto& r : readings) magnitude += r.norm() / static_cast<double>(readings.size());
   const Eigen::Vector3d d = -(fit_ * axial) / kGravity_m_per_s2;
-  if (!d.allFinite() || std::abs(d.norm() - 1.0) > 0.3 || std::abs(magnitude - kGravity_m_per_s2) > 3.0) {
+  if (!d.allFinite() || std::abs(d.norm() - 1.0) > 0.5 || std::abs(magnitude - kGravity_m_per_s2) > 5.0) {
     return std::nullopt;
   }
   return d.normalized();
