@@ -185,8 +185,7 @@ void add_drive_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.1, 100.0));
   cmd->add_flag("--sim", args->sim, "Drive the in-process model (its sensors emulated, with seeded noise)");
-  cmd->add_option("--robot", args->robot,
-                  "Robot description (default: the one the gaits name, else robots/superball-paper.json)")
+  cmd->add_option("--robot", args->robot, "Robot description (default: robots/superball-paper.json)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--gaits", args->gaits,
                   "Gait set file (tensegrity-gait-set/1; default: the shipped policy's symmetry images, with the "
