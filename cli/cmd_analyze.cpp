@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "cli/analysis_json.hpp"
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
+#include "sim/analysis/analysis_json.hpp"
 #include "sim/analysis/csv_files.hpp"
 #include "sim/model/core_controller.hpp"
 #include "robot/policy.hpp"
@@ -57,6 +57,35 @@ std::string python() {
   return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
 }
 
+// The readable form of the summary (sim/analysis/analysis_json.hpp).
+void print_analysis_summary(const nlohmann::json& j) {
+  const auto& m = j["rest_length_m"];
+  const auto& p = j["power_per_muscle_w"];
+  const auto& r = j["rolling"];
+  const auto& period = j["revolution_period_s"];
+  std::printf("  window           %.1f-%.1f s (%zu samples)\n", j["window_s"][0].get<double>(),
+              j["window_s"][1].get<double>(), j["samples"].get<std::size_t>());
+  std::printf("  rest lengths     %.3f-%.3f m, means %.3f-%.3f m\n", m["min"].get<double>(), m["max"].get<double>(),
+              m["mean_lowest"].get<double>(), m["mean_highest"].get<double>());
+  std::printf("  tension          mean %.1f N, peak %.1f N\n", j["tension_n"]["mean"].get<double>(),
+              j["tension_n"]["peak"].get<double>());
+  std::printf("  power per muscle mean %.2f W (muscles %.2f-%.2f W; 1 s mean %.2f-%.2f W)\n", p["mean"].get<double>(),
+              p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(), p["mean_over_1s_min"].get<double>(),
+              p["mean_over_1s_max"].get<double>());
+  const auto& from = r["face_cycle_from_s"];
+  std::printf(
+      "  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle, from %.1f s), %.2f s from "
+      "rotation\n",
+      period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
+      from.is_null() ? 0.0 : from.get<double>(), period["rotation"].get<double>());
+  std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
+              r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(),
+              r["face_sequence"].size(), r["slip_m_per_s"]["median"].get<double>());
+  std::printf("  clusters         %zu (zero lag), %zu (phase aligned) at 1 - r <= %.2f\n",
+              j["clusters"]["zero_lag"].size(), j["clusters"]["phase_aligned"].size(),
+              j["clusters"]["cut_height"].get<double>());
+}
+
 // Runs the plotting script; returns what happened, for the summary.
 std::string make_plots(const std::filesystem::path& dir) {
   const std::string py = python(), script = plot_script().string(), out = dir.string();
@@ -70,8 +99,13 @@ std::string make_plots(const std::filesystem::path& dir) {
   int status = 0;
   waitpid(pid, &status, 0);
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "written";
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 3) return "skipped: matplotlib is not installed for " + py;
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 127) return "skipped: " + py + " not found";
+  // tools/plot_analysis.py's own status when it cannot import matplotlib.
+  constexpr int kNoMatplotlib = 3;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kNoMatplotlib)
+    return "skipped: matplotlib is not installed for " + py;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == exit_status(ExitCode::cannot_exec)) {
+    return "skipped: " + py + " not found";
+  }
   return "failed: " + py + " " + script + " exited with status " + std::to_string(status);
 }
 
@@ -88,7 +122,8 @@ void run_analyze(const AnalyzeArgs& args) {
   std::fprintf(stderr, "analyze: %s on %s, %.0f s episode at %.0f Hz...\n", args.policy.c_str(), robot.name.c_str(),
                args.duration_s, 1.0 / (options.telemetry_every * robot.time_step_s));
   const sim::EpisodeResult result = sim::run_episode(robot, controller, options);
-  if (series.samples() < 4) throw CommandError(1, "analyze: the episode ended before 4 samples were recorded");
+  if (series.samples() < 4)
+    throw CommandError(ExitCode::failure, "analyze: the episode ended before 4 samples were recorded");
 
   sim::analysis::AnalysisOptions analysis_options;
   analysis_options.period_s = policy.period_s;
@@ -99,7 +134,7 @@ void run_analyze(const AnalyzeArgs& args) {
   const auto analysis = sim::analysis::analyze(series, cable_nodes, analysis_options);
 
   const std::filesystem::path dir = args.out;
-  nlohmann::json summary = analysis_json(series, analysis, analysis_options);
+  nlohmann::json summary = sim::analysis::analysis_json(series, analysis, analysis_options);
   summary["policy"] = args.policy;
   summary["robot"] = robot.name;
   summary["robot_hash"] = robot.hash;

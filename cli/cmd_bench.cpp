@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/benchmark_policy.hpp"
 #include "sim/model/episode.hpp"
 

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/evolve/curve_csv.hpp"
 #include "sim/evolve/driver.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
@@ -119,7 +119,7 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
                   100.0 * many.episodes_per_s / one.episodes_per_s / threads, identical ? "yes" : "NO");
     }
   }
-  if (!identical) throw CommandError(1, "bench evolve: the curve depends on the thread count");
+  if (!identical) throw CommandError(ExitCode::failure, "bench evolve: the curve depends on the thread count");
 }
 
 }  // namespace

@@ -171,8 +171,10 @@ ModeResult run_mode(const BenchHilArgs& args, hil::StepperMode mode, double dura
   RunSampler sampler(steps);
   sampler.attach(o);
   ModeResult m{hil::run_hil(o), nullptr};
-  if (!m.result.ok) throw CommandError(1, std::string("bench hil (") + hil::to_string(mode) + "): " + m.result.error);
-  if (!sampler.complete()) throw CommandError(1, "bench hil: the run ended before its last step was sampled");
+  if (!m.result.ok)
+    throw CommandError(ExitCode::failure, std::string("bench hil (") + hil::to_string(mode) + "): " + m.result.error);
+  if (!sampler.complete())
+    throw CommandError(ExitCode::failure, "bench hil: the run ended before its last step was sampled");
   m.cpu = sampler.report(dt_s);
   return m;
 }

@@ -35,9 +35,10 @@ void check_report(const std::string& name, const ground::CommandReport& report) 
   if (!missing.empty()) {
     std::string list;
     for (const int e : missing) list += (list.empty() ? "" : ",") + std::to_string(e);
-    throw CommandError(1, name + ": no acknowledgement from end cap(s) " + list + " before the deadline");
+    throw CommandError(ExitCode::failure,
+                       name + ": no acknowledgement from end cap(s) " + list + " before the deadline");
   }
-  if (!report.all_accepted()) throw CommandError(1, name + ": not every end cap accepted");
+  if (!report.all_accepted()) throw CommandError(ExitCode::failure, name + ": not every end cap accepted");
 }
 
 // A console exists but did not send the command. A stop or estop then goes out from
@@ -46,11 +47,12 @@ void check_report(const std::string& name, const ground::CommandReport& report) 
 // the operator asked, and undo it (docs/design/dds.md, clear-fault).
 bool speak_instead(const std::string& name, const CommandArgs& args, ground::CommandKind kind,
                    const std::filesystem::path& socket, const std::string& why) {
-  if (!args.console.empty()) throw CommandError(1, name + ": the console did not send it: " + why);
+  if (!args.console.empty()) throw CommandError(ExitCode::failure, name + ": the console did not send it: " + why);
   if (kind == ground::CommandKind::clear_fault) {
-    throw CommandError(1, name + ": the console at " + socket.string() + " did not send it (" + why +
-                              "); not sent: look at the end caps (tensegrity status), then clear again (or "
-                              "--no-console)");
+    throw CommandError(ExitCode::failure,
+                       name + ": the console at " + socket.string() + " did not send it (" + why +
+                           "); not sent: look at the end caps (tensegrity status), then clear again (or "
+                           "--no-console)");
   }
   std::fprintf(stderr, "%s: the console at %s did not send it (%s); sending on this tool's own participant\n",
                name.c_str(), socket.c_str(), why.c_str());
@@ -76,7 +78,8 @@ bool through_console(const std::string& name, const CommandArgs& args, ground::C
     return speak_instead(name, args, kind, socket, std::string("it did not answer properly: ") + e.what());
   }
   if (!reply) {
-    if (!args.console.empty()) throw CommandError(1, name + ": no console listens at " + socket.string());
+    if (!args.console.empty())
+      throw CommandError(ExitCode::failure, name + ": no console listens at " + socket.string());
     return false;
   }
   const bool none_acked = reply->report.missing().size() == reply->report.results.size();

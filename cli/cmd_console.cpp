@@ -114,7 +114,7 @@ void run_console(const ConsoleArgs& args) {
   try {
     server = std::make_unique<ground::OperatorServer>([&keeper] { return keeper.current(); }, socket);
   } catch (const ground::OperatorLinkError& e) {
-    throw CommandError(1, std::string("console: ") + e.what());
+    throw CommandError(ExitCode::failure, std::string("console: ") + e.what());
   }
   const std::string security = station_opts.enclave_dir.empty() ? "UNSECURED" : "secured";
   std::fprintf(stderr, "console: domain %d (%s), relaying estop/stop/clear-fault at %s\n", station_opts.domain,
@@ -179,7 +179,8 @@ void run_console(const ConsoleArgs& args) {
   if (reports != shown_reports) std::printf("%s", last.c_str());
   std::fflush(stdout);
   if (const std::string unsure = commands.estop_unsure(); !unsure.empty()) {
-    throw CommandError(1, "console: the last emergency stop did not reach every end cap (" + unsure + ")");
+    throw CommandError(ExitCode::failure,
+                       "console: the last emergency stop did not reach every end cap (" + unsure + ")");
   }
 }
 

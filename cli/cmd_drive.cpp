@@ -12,7 +12,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/drive_sim.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "cli/shipped_policy.hpp"
 #include "robot/symmetry.hpp"
 #include "sim/model/episode.hpp"
@@ -37,7 +37,7 @@ struct DriveArgs {
 Eigen::Vector2d parse_waypoint(const std::string& text, std::size_t index) {
   const std::string field = "--to #" + std::to_string(index + 1) + " (\"" + text + "\")";
   const auto comma = text.find(',');
-  if (comma == std::string::npos) throw CommandError(2, "drive: " + field + ": expected X,Y in metres");
+  if (comma == std::string::npos) throw CommandError(ExitCode::usage, "drive: " + field + ": expected X,Y in metres");
   Eigen::Vector2d w;
   for (int k = 0; k < 2; ++k) {
     const std::string part = k == 0 ? text.substr(0, comma) : text.substr(comma + 1);
@@ -48,7 +48,7 @@ Eigen::Vector2d parse_waypoint(const std::string& text, std::size_t index) {
       used = 0;
     }
     if (used == 0 || used != part.size() || !std::isfinite(w[k]) || std::abs(w[k]) > 1e4) {
-      throw CommandError(2,
+      throw CommandError(ExitCode::usage,
                          "drive: " + field + ": " + (k == 0 ? "X" : "Y") + " is not a number of metres within 10 km");
     }
   }
@@ -60,7 +60,8 @@ Eigen::Vector2d parse_waypoint(const std::string& text, std::size_t index) {
 sim::GaitSet symmetry_gait_set(const sim::Robot& robot, const std::string& policy_path) {
   const sim::Policy source = sim::load_policy(policy_path, robot);
   if (!source.provenance.heading_deg) {
-    throw CommandError(2, "drive: " + policy_path + " records no heading (provenance.gait.heading_deg); give --gaits");
+    throw CommandError(ExitCode::usage,
+                       "drive: " + policy_path + " records no heading (provenance.gait.heading_deg); give --gaits");
   }
   const auto group = sim::symmetry_group(robot);
   const auto faces = sim::hull_faces(robot);
@@ -68,7 +69,7 @@ sim::GaitSet symmetry_gait_set(const sim::Robot& robot, const std::string& polic
   model.restore(sim::settled_state(robot, robot.time_step_s));
   const auto nodes = model.node_positions();
   const int start = sim::start_frame(robot, faces, nodes).face;
-  if (start < 0) throw CommandError(1, "drive: the robot's hull has no faces to stand on");
+  if (start < 0) throw CommandError(ExitCode::failure, "drive: the robot's hull has no faces to stand on");
   const double h = *source.provenance.heading_deg * std::numbers::pi / 180.0;
   sim::GaitSet set{robot.name, robot.hash, policy_path, 60.0, {}};
   for (const sim::Symmetry& s : group) {
@@ -124,7 +125,8 @@ nlohmann::json outcome_json(const DriveOutcome& o, const DriveArgs& args, const 
 
 void run_drive(const DriveArgs& args) {
   if (!args.sim) {
-    throw CommandError(2, "drive: only --sim (the in-process model) is available; the end caps over DDS are not yet");
+    throw CommandError(ExitCode::usage,
+                       "drive: only --sim (the in-process model) is available; the end caps over DDS are not yet");
   }
   const std::string policy = args.gaits.empty() ? shipped_policy_or("").string() : "";
   const sim::Robot robot = load_robot_arg(args.robot, policy);
@@ -166,7 +168,7 @@ void run_drive(const DriveArgs& args) {
   }
   bool all = o.completed;
   for (const auto& w : o.waypoints) all = all && w.reached;
-  if (!all) throw CommandError(1, "drive: the course was not completed");
+  if (!all) throw CommandError(ExitCode::failure, "drive: the course was not completed");
 }
 
 }  // namespace

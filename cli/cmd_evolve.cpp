@@ -16,41 +16,21 @@
 
 #include "cli/commands.hpp"
 #include "cli/evolve_mpi.hpp"
-#include "cli/evolve_policy.hpp"
 #include "cli/evolve_progress.hpp"
 #include "sim/evolve/checkpoint.hpp"
-#include "sim/evolve/driver.hpp"
-#include "sim/model/core_controller.hpp"
-#include "sim/model/episode.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
+#include "sim/evolve/evolve_run.hpp"
 
 namespace tensegrity::cli {
 namespace {
 
+// The use case's options (sim/evolve/evolve_run.hpp), and how this process runs it.
 struct EvolveArgs {
-  double period_s = 4.0;
-  int complexity = 5;
-  std::string method = "historical";
-  std::int64_t episodes = 5000;
-  std::uint64_t seed = 1;
+  sim::evolve::EvolveRequest request;
   int threads = 0;
   std::string checkpoint;
   bool resume = false;
   std::string robot;
-  int population = sim::evolve::EvolveConfig{}.population;
-  int teams = sim::evolve::EvolveConfig{}.teams;
-  int replace = sim::evolve::EvolveConfig{}.replace;
-  std::string mutation = "gaussian";
-  // Negative: not given. With none of the four given the Gaussian operator breeds with
-  // kDefaultGaussianSchedule; with any given, the user sets the schedule: the step
-  // defaults to the operator's own, the final step to the step, the rest to 0.
-  double sigma_m = -1.0;
-  double sigma_final_m = -1.0;
-  std::int64_t anneal_episodes = -1;
-  std::int64_t anneal_start_episodes = -1;
-  double duration_s = 60.0;
-  double dt_s = 0.0;
-  double early_end_m = -1.0;  // negative: the robot's learning.early_end
   std::string out;
   std::string log;
   bool json = false;
@@ -74,89 +54,34 @@ struct RobotArg {
 RobotArg read_robot_arg(const std::string& arg) {
   const std::filesystem::path path = arg.empty() ? sim::default_robot_path() : std::filesystem::path(arg);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw CommandError(2, path.string() + ": cannot open robot description");
+  if (!in) throw CommandError(ExitCode::usage, path.string() + ": cannot open robot description");
   std::ostringstream text;
   text << in.rdbuf();
   try {
     sim::Robot robot = sim::parse_robot(text.str(), path.string());
     return RobotArg{text.str(), std::move(robot)};
   } catch (const sim::RobotError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
-}
-
-// The mutation step's schedule from the options (EvolveArgs says which defaults apply).
-void set_step_schedule(sim::evolve::EvolveConfig& config, const EvolveArgs& args) {
-  const bool given =
-      args.sigma_m >= 0.0 || args.sigma_final_m >= 0.0 || args.anneal_episodes >= 0 || args.anneal_start_episodes >= 0;
-  if (!given && config.mutation == sim::evolve::Mutation::gaussian) {
-    const auto& s = sim::evolve::kDefaultGaussianSchedule;
-    config.sigma_m = s.sigma_m;
-    config.sigma_final_m = s.sigma_final_m;
-    config.anneal_start_episodes = s.anneal_start_episodes;
-    config.anneal_episodes = s.anneal_episodes;
-    return;
-  }
-  // Each operator's own step: 0.05 m for the Gaussian (a tenth of the 0.5 m range),
-  // 0.03 of the range for the author's (NTRT's NeuroEvoMember::mutate).
-  const double range_m = config.max_rest_length_m - config.min_rest_length_m;
-  const double default_sigma_m = config.mutation == sim::evolve::Mutation::author
-                                     ? sim::evolve::kAuthorSigmaShareOfRange * range_m
-                                     : sim::evolve::kDefaultGaussianSchedule.sigma_m;
-  config.sigma_m = args.sigma_m < 0.0 ? default_sigma_m : args.sigma_m;
-  config.sigma_final_m = args.sigma_final_m < 0.0 ? config.sigma_m : args.sigma_final_m;
-  config.anneal_episodes = std::max<std::int64_t>(args.anneal_episodes, 0);
-  config.anneal_start_episodes = std::max<std::int64_t>(args.anneal_start_episodes, 0);
 }
 
 sim::evolve::EvolveConfig evolve_config(const EvolveArgs& args, const sim::Robot& robot) {
-  sim::evolve::EvolveConfig config;
   try {
-    config.method = sim::evolve::parse_fitness_method(args.method);
+    return sim::evolve::request_config(args.request, robot);
   } catch (const sim::evolve::ConfigError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
-  config.population = args.population;
-  config.teams = args.teams;
-  config.replace = args.replace;
-  config.mutation = sim::evolve::parse_mutation(args.mutation);
-  sim::evolve::set_robot(config, robot);
-  set_step_schedule(config, args);
-  config.seed = args.seed;
-  config.episodes = args.episodes;
-  config.complexity = args.complexity;
-  config.period_s = args.period_s;
-  config.duration_s = args.duration_s;
-  // The robot's own step asked for by name is the robot's own step: the same run, and
-  // the same checkpoint, as one at a robot without a learning step of its own.
-  config.dt_s =
-      args.dt_s > 0.0 ? (args.dt_s == robot.time_step_s ? 0.0 : args.dt_s) : sim::evolve::default_learning_dt_s(robot);
-  sim::evolve::set_default_early_end(config, robot);
-  if (args.early_end_m >= 0.0) {
-    if (args.early_end_m > 0.0 && config.early_end_speed_m_per_s <= 0.0) {
-      throw CommandError(2, "--early-end: the robot has no learning.early_end.max_speed_m_per_s to bound progress by");
-    }
-    config.early_end_bar_m = args.early_end_m;
-  }
-  try {
-    sim::evolve::validate(config);
-  } catch (const sim::evolve::ConfigError& e) {
-    throw CommandError(2, e.what());
-  }
-  return config;
 }
 
 // What the summary shows beside the evolution itself.
-struct EvolveOutcome {
-  sim::evolve::DriverResult result;
-  sim::evolve::TeamResult final_result;
-  double wall_s = 0.0;
+struct EvolveSummary {
+  sim::evolve::EvolveOutcome run;
   int threads = 0;
-  sim::EpisodeResult gait;
 };
 
-void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveOutcome& o,
+void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveSummary& summary,
                 EvolveMpi* mpi) {
+  const sim::evolve::EvolveOutcome& o = summary.run;
   const auto& evo = o.result.evolution;
   const std::int64_t episodes_here = evo.episodes() - o.result.resumed_episodes;
   nlohmann::json j = {{"best_score_m", evo.best().score_m},
@@ -168,7 +93,7 @@ void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
                       {"generations", evo.generation()},
                       {"infeasible_rate_last", evo.curve().empty() ? 0.0 : evo.curve().back().infeasible_rate()},
                       {"resumed", o.result.resumed},
-                      {"threads", o.threads},
+                      {"threads", summary.threads},
                       {"ranks", mpi != nullptr ? mpi->ranks() : 1},
                       {"wall_time_s", o.wall_s},
                       {"episodes_per_s", o.wall_s > 0.0 ? static_cast<double>(episodes_here) / o.wall_s : 0.0},
@@ -187,8 +112,9 @@ void print_json(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
   std::printf("%s\n", j.dump(2).c_str());
 }
 
-void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveOutcome& o,
+void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config, const EvolveSummary& summary,
                 EvolveMpi* mpi) {
+  const sim::evolve::EvolveOutcome& o = summary.run;
   const auto& evo = o.result.evolution;
   const auto& best = evo.best();
   const std::int64_t episodes_here = evo.episodes() - o.result.resumed_episodes;
@@ -208,7 +134,7 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
   std::printf("  struts     %.3f m apart at the closest, overlapping for %.2f s\n", o.gait.min_strut_gap_m,
               o.gait.strut_overlap_s);
   if (o.gait.travel.heading_deg) std::printf("  heading    %+.1f deg in the start frame\n", *o.gait.travel.heading_deg);
-  std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", o.wall_s, rate, o.threads);
+  std::printf("  time       %.1f s wall, %.2f episodes/s on %d threads", o.wall_s, rate, summary.threads);
   if (mpi != nullptr) std::printf(" over %d MPI ranks", mpi->ranks());
   std::printf("\n");
   if (mpi != nullptr) {
@@ -220,34 +146,24 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
   std::printf("  policy     %s\n  curve      %s\n", args.out.c_str(), args.log.c_str());
 }
 
-// Evolves to the budget (or from the checkpoint on), then evaluates the best team
-// once more, alone: its score and feasibility as the policy file reports them (the
-// model is deterministic, so this confirms the recorded score).
-EvolveOutcome evolve(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
-                     sim::evolve::Evaluator& evaluator) {
+// Evolves (sim/evolve/evolve_run.hpp) with the progress line on a terminal.
+sim::evolve::EvolveOutcome evolve(const EvolveArgs& args, const sim::Robot& robot,
+                                  const sim::evolve::EvolveConfig& config, sim::evolve::Evaluator& evaluator) {
   EvolveProgress progress(isatty(STDERR_FILENO) == 1, config.episodes);
-  sim::evolve::DriverOptions options;
-  options.checkpoint_dir = args.checkpoint;
-  options.resume = args.resume;
-  options.curve_csv = args.log;
-  options.on_generation = [&](const sim::evolve::Coevolution& evo, const sim::evolve::GenerationStats& stats) {
-    progress.update(evo, stats);
-  };
-  const auto started = std::chrono::steady_clock::now();
-  EvolveOutcome o{[&] {
-                    try {
-                      return sim::evolve::drive(config, evaluator, options);
-                    } catch (const sim::evolve::CheckpointError& e) {
-                      throw CommandError(3, e.what());
-                    }
-                  }(),
-                  sim::evolve::TeamResult{}, 0.0, 0, sim::EpisodeResult{}};
-  progress.finish();
-  for (const auto& w : o.result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
-  const std::vector<sim::evolve::Team> final_team{o.result.evolution.best().team};
-  o.final_result = evaluator.evaluate(final_team).front();
-  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return o;
+  const sim::evolve::RunFiles files{args.out, args.log, args.checkpoint, args.resume};
+  try {
+    sim::evolve::EvolveOutcome o =
+        sim::evolve::run_evolution(robot, config, evaluator, files,
+                                   [&](const sim::evolve::Coevolution& evo, const sim::evolve::GenerationStats& stats) {
+                                     progress.update(evo, stats);
+                                   });
+    progress.finish();
+    for (const auto& w : o.result.warnings) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
+    return o;
+  } catch (const sim::evolve::CheckpointError& e) {
+    progress.finish();
+    throw CommandError(ExitCode::checkpoint, e.what());
+  }
 }
 
 // `mpi` is rank 0's side of an MPI run; null: evaluate on this machine's threads.
@@ -255,11 +171,6 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   const RobotArg robot_arg = read_robot_arg(args.robot);
   const sim::Robot& robot = robot_arg.robot;
   const sim::evolve::EvolveConfig config = evolve_config(args, robot);
-
-  // Hours of evolution must not end in "cannot write": make the output's directory now.
-  const std::filesystem::path out_path(args.out);
-  if (out_path.has_parent_path()) std::filesystem::create_directories(out_path.parent_path());
-
   std::unique_ptr<sim::evolve::Evaluator> threaded;
   int threads = 0;
   if (mpi == nullptr) {
@@ -268,27 +179,22 @@ void run_evolve(const EvolveArgs& args, EvolveMpi* mpi) {
   }
   sim::evolve::Evaluator& evaluator = mpi != nullptr ? mpi->evaluator(robot_arg.text, robot, config) : *threaded;
   if (mpi != nullptr) threads = mpi->threads();
-
-  EvolveOutcome outcome = evolve(args, config, evaluator);
-  outcome.threads = threads;
-  sim::Policy policy = best_policy(robot, config, outcome.result.evolution, outcome.final_result.score_m);
-  outcome.gait = play_gait(robot, config, policy);
-  sim::save_policy(args.out, policy);
+  const EvolveSummary summary{evolve(args, robot, config, evaluator), threads};
   if (args.json) {
-    print_json(args, config, outcome, mpi);
+    print_json(args, config, summary, mpi);
   } else {
-    print_text(args, config, outcome, mpi);
+    print_text(args, config, summary, mpi);
   }
 }
 
 // The mutation operator and its step's schedule.
 void add_mutation_options(CLI::App& cmd, EvolveArgs& args) {
-  cmd.add_option("--mutation", args.mutation,
+  cmd.add_option("--mutation", args.request.mutation,
                  "Mutation operator: gaussian (every value of a copy) or author (NTRT's: half the copies, half "
                  "their values)")
       ->capture_default_str()
       ->check(CLI::IsMember({"author", "gaussian"}));
-  cmd.add_option("--sigma", args.sigma_m,
+  cmd.add_option("--sigma", args.request.sigma_m,
                  "Mutation step, metres, clamped to the limits (default for gaussian: 0.05, annealed to 0.02 "
                  "over episodes 2000-5000 unless a step option is given; for author: 0.03 of the rest-length "
                  "range, constant)")
@@ -296,14 +202,14 @@ void add_mutation_options(CLI::App& cmd, EvolveArgs& args) {
   // The schedule's three options go together: a step given without its episodes
   // (or the reverse) would be silently ignored.
   CLI::Option* sigma_final =
-      cmd.add_option("--sigma-final", args.sigma_final_m,
+      cmd.add_option("--sigma-final", args.request.sigma_final_m,
                      "Mutation step after --anneal-episodes, metres (default: no annealing once any step option "
                      "is given)")
           ->check(CLI::Range(0.0, 10.0));
-  CLI::Option* anneal = cmd.add_option("--anneal-episodes", args.anneal_episodes,
+  CLI::Option* anneal = cmd.add_option("--anneal-episodes", args.request.anneal_episodes,
                                        "Episodes over which the step goes geometrically from --sigma to --sigma-final")
                             ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
-  CLI::Option* anneal_start = cmd.add_option("--anneal-start", args.anneal_start_episodes,
+  CLI::Option* anneal_start = cmd.add_option("--anneal-start", args.request.anneal_start_episodes,
                                              "Episodes at the constant --sigma before annealing begins (default 0)")
                                   ->check(CLI::Range(std::int64_t{0}, std::int64_t{1} << 40));
   sigma_final->needs(anneal);
@@ -332,19 +238,19 @@ void add_evolve_command(CLI::App& app) {
   auto args = std::make_shared<EvolveArgs>();
   CLI::App* cmd =
       app.add_subcommand("evolve", "Coevolve a rolling policy (cooperative coevolution, paper Algorithm 1)");
-  cmd->add_option("--period", args->period_s, "Signal period, seconds")
+  cmd->add_option("--period", args->request.period_s, "Signal period, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 3600.0));
-  cmd->add_option("--complexity", args->complexity, "Values per cable signal")
+  cmd->add_option("--complexity", args->request.complexity, "Values per cable signal")
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
-  cmd->add_option("--method", args->method, "Fitness: historical|leniency|average")
+  cmd->add_option("--method", args->request.method, "Fitness: historical|leniency|average")
       ->capture_default_str()
       ->check(CLI::IsMember({"historical", "leniency", "average"}));
-  cmd->add_option("--episodes", args->episodes, "Episode budget")
+  cmd->add_option("--episodes", args->request.episodes, "Episode budget")
       ->capture_default_str()
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1} << 40));
-  cmd->add_option("--seed", args->seed, "Random seed (the run depends on it alone)")->capture_default_str();
+  cmd->add_option("--seed", args->request.seed, "Random seed (the run depends on it alone)")->capture_default_str();
   cmd->add_option("--threads", args->threads,
                   "Worker threads (default: all cores; with --mpi per rank, the CPUs it may use); results do not "
                   "depend on it")
@@ -355,24 +261,24 @@ void add_evolve_command(CLI::App& app) {
   // Not checked by the parser: with --mpi only rank 0 reads it, the other machines need no copy.
   cmd->add_option("--robot", args->robot,
                   "Robot description (default: robots/superball-paper.json, the paper's model)");
-  cmd->add_option("--population", args->population, "Members per cable population")
+  cmd->add_option("--population", args->request.population, "Members per cable population")
       ->capture_default_str()
       ->check(CLI::Range(2, 100000));
-  cmd->add_option("--teams", args->teams, "Random teams per generation")
+  cmd->add_option("--teams", args->request.teams, "Random teams per generation")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--replace", args->replace, "Worst members replaced per generation")
+  cmd->add_option("--replace", args->request.replace, "Worst members replaced per generation")
       ->capture_default_str()
       ->check(CLI::Range(1, 50000));
   add_mutation_options(*cmd, *args);
-  cmd->add_option("--duration", args->duration_s, "Episode length, seconds")
+  cmd->add_option("--duration", args->request.duration_s, "Episode length, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 3600.0));
-  cmd->add_option("--dt", args->dt_s,
+  cmd->add_option("--dt", args->request.dt_s,
                   "Time step teams are scored at, seconds (default: the robot's learning.time_step_s, else its "
                   "time_step_s; docs/design/performance.md)")
       ->check(CLI::Range(1e-5, 0.01));
-  cmd->add_option("--early-end", args->early_end_m,
+  cmd->add_option("--early-end", args->request.early_end_m,
                   "End a team's episode once it provably cannot roll this many metres (default: the robot's "
                   "learning.early_end.bar_m; 0: every episode runs to its end; docs/design/performance.md)")
       ->check(CLI::Range(0.0, 1000.0));
@@ -381,7 +287,8 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "Print a JSON summary");
   add_mpi_options(*cmd, *args);
   cmd->callback([args] {
-    if (args->resume && args->checkpoint.empty()) throw CommandError(2, "--resume needs --checkpoint DIR");
+    if (args->resume && args->checkpoint.empty())
+      throw CommandError(ExitCode::usage, "--resume needs --checkpoint DIR");
     check_evolve_launch(args->mpi);
     if (!args->mpi) {
       run_evolve(*args, nullptr);

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/core_controller.hpp"
 #include "sim/model/episode.hpp"
 #include "robot/gait_set.hpp"
@@ -67,7 +67,7 @@ void run_symmetries(const GaitsArgs& args) {
   const auto group = sim::symmetry_group(robot);
   const auto faces = sim::hull_faces(robot);
   const int start = settled_face(robot, faces);
-  if (start < 0) throw CommandError(1, "gaits: the robot's hull has no faces to stand on");
+  if (start < 0) throw CommandError(ExitCode::failure, "gaits: the robot's hull has no faces to stand on");
   nlohmann::json list = nlohmann::json::array();
   for (const sim::Symmetry& s : group) {
     const int image = sim::face_image(s, faces, start);
@@ -124,7 +124,8 @@ void run_transform(const GaitsArgs& args) {
   sim::Policy image = sim::image_of(source, sim::find_symmetry(group, args.symmetry), robot);
   if (args.measure) {
     const sim::EpisodeResult r = play(robot, image, args.duration_s);
-    if (!r.feasible) throw CommandError(1, "gaits transform: the image is infeasible: " + r.infeasible_reason);
+    if (!r.feasible)
+      throw CommandError(ExitCode::failure, "gaits transform: the image is infeasible: " + r.infeasible_reason);
     record_gait(image, r);
     std::printf("%s from the settled start: %.2f m in %.0f s\n", args.symmetry.c_str(), r.distance_m, args.duration_s);
     print_heading(r.travel, r.start_face);
@@ -141,10 +142,10 @@ void run_set(const GaitsArgs& args) {
   const auto group = sim::symmetry_group(robot);
   const auto faces = sim::hull_faces(robot);
   const int start = settled_face(robot, faces);
-  if (start < 0) throw CommandError(1, "gaits: the robot's hull has no faces to stand on");
+  if (start < 0) throw CommandError(ExitCode::failure, "gaits: the robot's hull has no faces to stand on");
   const sim::EpisodeResult base = play(robot, source, args.duration_s);
   if (!base.feasible || !base.travel.heading_deg) {
-    throw CommandError(1, "gaits set: " + args.policy + " does not roll from the settled start");
+    throw CommandError(ExitCode::failure, "gaits set: " + args.policy + " does not roll from the settled start");
   }
   sim::GaitSet set{robot.name, robot.hash, args.policy, args.duration_s, {}};
   for (const sim::Symmetry& s : group) {

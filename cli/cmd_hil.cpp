@@ -75,10 +75,11 @@ hil::HilOptions make_options(const HilArgs& a) {
   o.endcap_binary = a.endcap;
   o.barrier_timeout_s = a.barrier_timeout_s;
   if (a.speed >= 0.0 && o.mode != hil::StepperMode::lockstep) {
-    throw CommandError(2, "hil: --speed is for lockstep runs (a realtime run keeps to the wall clock)");
+    throw CommandError(ExitCode::usage, "hil: --speed is for lockstep runs (a realtime run keeps to the wall clock)");
   }
   // A factor near 0 would sleep for days between ticks, deaf to Ctrl-C.
-  if (a.speed > 0.0 && a.speed < 0.01) throw CommandError(2, "hil: --speed must be 0 (no limit) or 0.01..1000");
+  if (a.speed > 0.0 && a.speed < 0.01)
+    throw CommandError(ExitCode::usage, "hil: --speed must be 0 (no limit) or 0.01..1000");
   o.max_speed = a.speed >= 0.0 ? a.speed : (a.view && o.mode == hil::StepperMode::lockstep ? 1.0 : 0.0);
   o.keep_dir = a.keep;
   o.provision = a.provision == "local" ? hil::Provision::local : hil::Provision::dds;
@@ -88,7 +89,7 @@ hil::HilOptions make_options(const HilArgs& a) {
   // Secured unless --insecure, with --keystore DIR or the default keystore; the HIL
   // runs both ends, so it makes the keystore if there is none yet.
 #ifdef TENSEGRITY_CLI_DDS
-  if (a.secure && a.insecure) throw CommandError(2, "hil: --secure and --insecure exclude each other");
+  if (a.secure && a.insecure) throw CommandError(ExitCode::usage, "hil: --secure and --insecure exclude each other");
   if (!a.insecure) o.dds_keystore = a.keystore.empty() ? msgs::default_keystore() : std::filesystem::path(a.keystore);
 #endif
   const sim::Robot robot =
@@ -105,7 +106,7 @@ hil::HilOptions make_options(const HilArgs& a) {
     hil::sort_events(o.scenario);
     hil::check_scenario(o.scenario, robot);
   } catch (const hil::HilError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
   return o;
 }
@@ -117,7 +118,7 @@ hil::HilOptions make_options(const HilArgs& a) {
 std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& o, const sim::Robot& robot) {
   if (!args.view) return nullptr;
   if (o.provision != hil::Provision::dds)
-    throw CommandError(2, "hil: --view needs --provision dds (the end caps' DDS link)");
+    throw CommandError(ExitCode::usage, "hil: --view needs --provision dds (the end caps' DDS link)");
   if (o.dds_domain < 0) o.dds_domain = hil::DomainLease(-1).domain();
   std::unique_ptr<view::LiveView> v;
   try {
@@ -128,7 +129,7 @@ std::unique_ptr<view::LiveView> open_view(const HilArgs& args, hil::HilOptions& 
     }
     v = std::make_unique<view::LiveView>(robot, o.dds_domain, to_server_options(args.view_server), enclave);
   } catch (const std::exception& e) {
-    throw CommandError(2, std::string("hil --view: ") + e.what());
+    throw CommandError(ExitCode::usage, std::string("hil --view: ") + e.what());
   }
   std::fprintf(stderr, "view: live page of this run (DDS domain %d) at %s\n", o.dds_domain, v->url().c_str());
   if (args.view_wait_s > 0) {
@@ -157,7 +158,7 @@ void run_hil_command(const HilArgs& args) {
   } else {
     std::printf("%s", hil::summary_text(r).c_str());
   }
-  if (!r.ok) throw CommandError(1, "hil: " + r.error);
+  if (!r.ok) throw CommandError(ExitCode::failure, "hil: " + r.error);
 }
 
 }  // namespace
@@ -178,7 +179,7 @@ void add_hil_command(CLI::App& app) {
   cmd->add_option("--scenario", args->scenario, "Fault scenario (tensegrity-hil-scenario/1 JSON)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--fault", args->faults, "One fault, ENDCAP:FAULT@TIME_S (repeatable), e.g. 3:drive_fault@2.0");
-  cmd->add_option("--record", args->record, "Per-tick CSV: time, centre, rest lengths, tensions");
+  cmd->add_option("--record", args->record, "Run record CSV, one row per physics step (as sim --telemetry)");
   cmd->add_option("--endcap", args->endcap,
                   "The endcap program (default: the one built with this tree, or $TENSEGRITY_ENDCAP)");
   cmd->add_option("--barrier-timeout", args->barrier_timeout_s, "Lockstep: seconds to wait for an end cap's targets")

@@ -31,7 +31,7 @@ void add_record_command(CLI::App& app) {
   add_ground_options(*cmd, args->ground, 5.0);
   cmd->callback([args] {
     std::FILE* f = std::fopen(args->out.c_str(), "w");
-    if (f == nullptr) throw CommandError(1, "cannot write " + args->out);
+    if (f == nullptr) throw CommandError(ExitCode::failure, "cannot write " + args->out);
     std::fputs(
         "receive_host_ns,endcap,seq,host_time_ns,loop_time_ns,cycle,mode,fault,subinterval,motor_count,"
         "commanded_m_0,commanded_m_1,commanded_m_2,commanded_m_3,measured_m_0,measured_m_1,measured_m_2,"

@@ -35,7 +35,7 @@ void add_revoke(CLI::App& security) {
     try {
       r = ground::revoke_enclave(dir, enclave, args->days);
     } catch (const ground::KeystoreError& e) {
-      throw CommandError(1, e.what());
+      throw CommandError(ExitCode::failure, e.what());
     }
     std::printf("revoked %s certificate serial %s (%d on the list); its new serial %s\n", enclave.c_str(),
                 r.revoked_serial.c_str(), r.revoked_total, r.new_serial.c_str());
@@ -72,7 +72,7 @@ void add_security_command(CLI::App& app) {
     try {
       ground::create_keystore(dir, init->options);
     } catch (const ground::KeystoreError& e) {
-      throw CommandError(1, e.what());
+      throw CommandError(ExitCode::failure, e.what());
     }
     std::printf("keystore %s: CA, %zu enclaves (ground, endcap_00..11, listener), valid %d days\n",
                 dir.string().c_str(), msgs::all_enclaves().size(), init->options.valid_days);
@@ -86,7 +86,8 @@ void add_security_command(CLI::App& app) {
   check->add_option("dir", *check_dir, "Keystore folder (default as for init)");
   check->callback([check_dir] {
     const std::filesystem::path dir = check_dir->empty() ? msgs::default_keystore() : std::filesystem::path(*check_dir);
-    if (const std::string problem = ground::keystore_problem(dir); !problem.empty()) throw CommandError(1, problem);
+    if (const std::string problem = ground::keystore_problem(dir); !problem.empty())
+      throw CommandError(ExitCode::failure, problem);
     std::printf("keystore %s: complete (%zu enclaves)\n", dir.string().c_str(), msgs::all_enclaves().size());
   });
   add_revoke(*security);

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/benchmark_policy.hpp"
 #include "sim/model/episode.hpp"
 
@@ -80,7 +80,8 @@ void run_sim(const SimArgs& args) {
     lead.telemetry = nullptr;
     lead.end_state = &after_first;
     const sim::EpisodeResult r = sim::run_episode(robot, *first, lead);
-    if (!r.feasible) throw CommandError(1, "sim: --first " + args.first + " is infeasible: " + r.infeasible_reason);
+    if (!r.feasible)
+      throw CommandError(ExitCode::failure, "sim: --first " + args.first + " is infeasible: " + r.infeasible_reason);
     options.start_state = &after_first;
     char after[64];
     std::snprintf(after, sizeof after, " for %.4g s, then ", args.first_s);
@@ -125,7 +126,7 @@ void add_sim_command(CLI::App& app) {
                                 "Start: settled (at rest on the ground; default with --policy) or drop "
                                 "(the benchmark's start; default without)")
                     ->check(CLI::IsMember({"settled", "drop"}));
-  cmd->add_option("--telemetry", args->telemetry, "Write per-step telemetry to this CSV file");
+  cmd->add_option("--telemetry", args->telemetry, "Run record CSV, one row per recorded step (as hil --record)");
   cmd->add_option("--telemetry-every", args->telemetry_every, "Record every N-th step")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -37,7 +37,7 @@ void add_start_command(CLI::App& app) {
       delay_s = std::stod(text, &used);
       if (used != text.size() || !(delay_s >= 0.0 && delay_s <= 60.0)) throw std::out_of_range(text);
     } catch (const std::exception&) {
-      throw CommandError(2, "--at '" + args->at + "': expected +S with S in 0..60 seconds");
+      throw CommandError(ExitCode::usage, "--at '" + args->at + "': expected +S with S in 0..60 seconds");
     }
     auto station = make_station(args->ground);
     if (!wait_for_endcaps(*station, args->ground, true)) {
@@ -50,7 +50,7 @@ void add_start_command(CLI::App& app) {
     const ground::CommandReport report = ground::send_command(*station, ground::CommandKind::start, t, options);
     std::printf("start at host time %.3f s (in %.3f s)\n%s", static_cast<double>(t) / 1e9, delay_s,
                 ground::format_command_report(report).c_str());
-    if (!report.all_accepted()) throw CommandError(1, "start: not every end cap accepted");
+    if (!report.all_accepted()) throw CommandError(ExitCode::failure, "start: not every end cap accepted");
     if (args->no_confirm) return;
     std::printf("waiting up to %.1f s after the start time for telemetry that shows every end cap playing\n",
                 args->confirm_within_s);
@@ -66,7 +66,7 @@ void add_start_command(CLI::App& app) {
                     "start: acked, but not every end cap is playing %.1f s after the start time (look: tensegrity "
                     "status; the others play: tensegrity stop)",
                     args->confirm_within_s);
-      throw CommandError(1, why);
+      throw CommandError(ExitCode::failure, why);
     }
   });
 }

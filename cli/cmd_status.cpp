@@ -56,7 +56,7 @@ void add_status_command(CLI::App& app) {
                       "status: no heartbeat (or none for %.0f s) within %.1f s from end cap(s) %s of --endcaps %s",
                       ground::Station::kHeardFreshS, args->ground.timeout_s, list.c_str(),
                       args->ground.endcaps.c_str());
-        throw CommandError(1, text);
+        throw CommandError(ExitCode::failure, text);
       }
       return;
     }

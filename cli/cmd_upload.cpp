@@ -38,7 +38,7 @@ void add_upload_command(CLI::App& app) {
     fw::comms::PolicyIdentity identity;
     identity.policy_id = args->id.empty() ? std::filesystem::path(args->policy).stem().string() : args->id;
     if (identity.policy_id.empty() || identity.policy_id.size() > 64) {
-      throw CommandError(2, "policy id '" + identity.policy_id + "' must be 1..64 characters (--id)");
+      throw CommandError(ExitCode::usage, "policy id '" + identity.policy_id + "' must be 1..64 characters (--id)");
     }
     identity.policy_version =
         args->version > 0 ? static_cast<std::uint32_t>(args->version) : static_cast<std::uint32_t>(std::time(nullptr));
@@ -59,7 +59,8 @@ void add_upload_command(CLI::App& app) {
                 robot.name.c_str(), tables.size());
     const ground::UploadReport report = ground::upload(*station, tables, options);
     std::printf("%s", ground::format_upload_report(report).c_str());
-    if (!report.all_accepted()) throw CommandError(1, "upload incomplete: not every end cap accepted the policy");
+    if (!report.all_accepted())
+      throw CommandError(ExitCode::failure, "upload incomplete: not every end cap accepted the policy");
     std::printf("all %zu end caps accepted in %.1f ms\n", report.results.size(), report.total_s * 1e3);
   });
 }

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 #include "cli/ground_cli.hpp"
 #include "cli/view_options.hpp"
 #include "msgs/dds.hpp"
@@ -41,7 +41,7 @@ void wait_for_signal() {
 
 void run_view(const ViewArgs& a) {
   const int modes = (a.run_csv.empty() ? 0 : 1) + (a.live ? 1 : 0) + (a.evolve_dir.empty() ? 0 : 1);
-  if (modes != 1) throw CommandError(2, "view: give one of RUN.csv, --live or --evolve DIR");
+  if (modes != 1) throw CommandError(ExitCode::usage, "view: give one of RUN.csv, --live or --evolve DIR");
   const view::ServerOptions server = to_server_options(a.server);
   try {
     if (!a.run_csv.empty()) {
@@ -67,7 +67,7 @@ void run_view(const ViewArgs& a) {
       wait_for_signal();
     }
   } catch (const view::InputError& e) {
-    throw CommandError(2, e.what());
+    throw CommandError(ExitCode::usage, e.what());
   }
 }
 

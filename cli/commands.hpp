@@ -4,19 +4,27 @@
 // A callback reports failure by throwing CommandError (exit code and message).
 #include <CLI/CLI.hpp>
 #include <stdexcept>
+#include <string>
+
+#include "core/exit_code.hpp"
 
 namespace tensegrity::cli {
 
+// `throw CommandError(ExitCode::usage, "--speed: must be ...")`: main prints the
+// message and exits with the code's number. The code is named (core/exit_code.hpp),
+// never a bare number, so every command's statuses stay one documented set.
 class CommandError : public std::runtime_error {
  public:
-  CommandError(int exit_code, const std::string& message) : std::runtime_error(message), exit_code_(exit_code) {}
-  int exit_code() const { return exit_code_; }
+  CommandError(ExitCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  ExitCode code() const { return code_; }
 
  private:
-  int exit_code_;
+  ExitCode code_;
 };
 
 void add_sim_command(CLI::App& app);
+// `robustness`: a gait across a perturbation set (sim/analysis/robustness.hpp).
+void add_robustness_command(CLI::App& app);
 // `analyze`: Figures 10-12 of one episode (sim/analysis/).
 void add_analyze_command(CLI::App& app);
 void add_bench_command(CLI::App& app);

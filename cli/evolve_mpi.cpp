@@ -21,19 +21,20 @@ void check_evolve_launch(bool mpi) {
   const auto launched = sim::evolve::mpi_launch_size();
   if (!mpi) {
     if (launched && *launched > 1) {
-      throw CommandError(2, "started by mpirun as " + std::to_string(*launched) +
-                                " processes without --mpi: each would run the whole evolution and write the "
-                                "same files; add --mpi");
+      throw CommandError(ExitCode::usage,
+                         "started by mpirun as " + std::to_string(*launched) +
+                             " processes without --mpi: each would run the whole evolution and write the "
+                             "same files; add --mpi");
     }
     return;
   }
   if (!sim::evolve::mpi_built()) {
-    throw CommandError(2,
+    throw CommandError(ExitCode::usage,
                        "--mpi: this tensegrity was built without MPI (install libopenmpi-dev and configure "
                        "with -DTENSEGRITY_WITH_MPI=ON)");
   }
   if (!launched) {
-    throw CommandError(2,
+    throw CommandError(ExitCode::usage,
                        "--mpi: not started by mpirun; run e.g. `mpirun -np 4 tensegrity evolve ... --mpi` "
                        "(docs/guide/evolve.md)");
   }
@@ -60,7 +61,7 @@ class Coordinator final : public EvolveMpi {
     } catch (const ev::MpiFailure&) {
       throw;
     } catch (const std::exception& e) {
-      throw CommandError(2, e.what());
+      throw CommandError(ExitCode::usage, e.what());
     }
     for (const auto& w : evaluator_->warnings()) std::fprintf(stderr, "tensegrity: warning: %s\n", w.c_str());
     return *evaluator_;
@@ -91,7 +92,7 @@ class Coordinator final : public EvolveMpi {
                "tensegrity: aborting the MPI job; the checkpoint (if any) holds the last whole generation: rerun "
                "with --resume\n",
                session.rank(), e.what());
-  session.abort(4);
+  session.abort(ExitCode::mpi);
 }
 
 }  // namespace
@@ -101,7 +102,7 @@ void run_evolve_mpi(const EvolveMpiArgs& args, const std::function<void(EvolveMp
   try {
     session = std::make_unique<ev::MpiSession>();
   } catch (const ev::MpiFailure& e) {
-    throw CommandError(4, std::string("--mpi: ") + e.what());
+    throw CommandError(ExitCode::mpi, std::string("--mpi: ") + e.what());
   }
   const int cpus = ev::usable_cpus();
   const int threads = args.threads > 0 ? args.threads : cpus;
@@ -138,7 +139,7 @@ void run_evolve_mpi(const EvolveMpiArgs& args, const std::function<void(EvolveMp
 #else
 
 void run_evolve_mpi(const EvolveMpiArgs&, const std::function<void(EvolveMpi&)>&) {
-  throw CommandError(2, "--mpi: this tensegrity was built without MPI");
+  throw CommandError(ExitCode::usage, "--mpi: this tensegrity was built without MPI");
 }
 
 #endif

@@ -34,7 +34,7 @@ class EvolveMpi {
   virtual nlohmann::json loads() const = 0;
 };
 
-// Throws CommandError(2) for a launch that cannot work: --mpi in a build without
+// Throws CommandError(ExitCode::usage) for a launch that cannot work: --mpi in a build without
 // MPI or outside mpirun, or mpirun with several processes but no --mpi (each would
 // run the whole evolution and write the same files).
 void check_evolve_launch(bool mpi);

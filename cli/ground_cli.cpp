@@ -43,10 +43,11 @@ std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore,
   const std::string where =
       named ? "no DDS Security keystore at " + store.string()
             : "no DDS Security keystore named (--keystore, TENSEGRITY_KEYSTORE) and none at " + store.string();
-  throw CommandError(2, where + ": create one with `tensegrity security init " + store.string() +
-                            "` (and give each end cap its enclave), name another with --keystore DIR or "
-                            "TENSEGRITY_KEYSTORE, or pass --insecure to speak to end caps that run without security "
-                            "(docs/guide/security.md)");
+  throw CommandError(ExitCode::usage,
+                     where + ": create one with `tensegrity security init " + store.string() +
+                         "` (and give each end cap its enclave), name another with --keystore DIR or "
+                         "TENSEGRITY_KEYSTORE, or pass --insecure to speak to end caps that run without security "
+                         "(docs/guide/security.md)");
 }
 
 std::uint16_t parse_endcap_set(const std::string& text) {
@@ -63,7 +64,7 @@ std::uint16_t parse_endcap_set(const std::string& text) {
       if (lo < 0 || hi >= ground::kEndcapCount || lo > hi) throw std::out_of_range(part);
       for (int i = lo; i <= hi; ++i) mask = static_cast<std::uint16_t>(mask | (1U << i));
     } catch (const std::exception&) {
-      throw CommandError(2, "--endcaps '" + text + "': bad part '" + part + "' (end caps are 0..11)");
+      throw CommandError(ExitCode::usage, "--endcaps '" + text + "': bad part '" + part + "' (end caps are 0..11)");
     }
     if (comma == std::string::npos) break;
     at = comma + 1;

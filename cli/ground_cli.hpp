@@ -27,12 +27,12 @@ struct GroundOptions {
 
 // The enclave of `role` (ground, or listener for read-only tools) in `keystore`, or
 // in the default keystore (msgs::default_keystore); empty (unsecured) only with
-// `insecure`. Throws CommandError(2), saying how to get one, when there is none.
+// `insecure`. Throws CommandError(ExitCode::usage), saying how to get one, when there is none.
 std::filesystem::path tool_enclave(msgs::Role role, const std::string& keystore, bool insecure);
 void add_security_options(CLI::App& cmd, std::string& keystore, bool& insecure);
 
 void add_ground_options(CLI::App& cmd, GroundOptions& options, double default_timeout_s);
-// "0-11", "3", "0,2,5-7" -> mask; throws CommandError(2) naming the bad part.
+// "0-11", "3", "0,2,5-7" -> mask; throws CommandError(ExitCode::usage) naming the bad part.
 std::uint16_t parse_endcap_set(const std::string& text);
 // What make_station builds (the enclave resolved once: a tool that rejoins makes
 // several stations from it).

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "tensegrity 0.1.0");
   tensegrity::cli::add_sim_command(app);
+  tensegrity::cli::add_robustness_command(app);
   tensegrity::cli::add_analyze_command(app);
   tensegrity::cli::add_bench_command(app);
   tensegrity::cli::add_evolve_command(app);
@@ -33,13 +34,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return exit_status(tensegrity::parse_exit(app.exit(e)));
   } catch (const tensegrity::cli::CommandError& e) {
     std::fprintf(stderr, "tensegrity: %s\n", e.what());
-    return e.exit_code();
+    return exit_status(e.code());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tensegrity: error: %s\n", e.what());
-    return 1;
+    return exit_status(tensegrity::ExitCode::failure);
   }
-  return 0;
+  return exit_status(tensegrity::ExitCode::ok);
 }

@@ -13,7 +13,7 @@ std::filesystem::path shipped_policy_or(const std::string& given) {
   const std::filesystem::path in_source = std::filesystem::path(TENSEGRITY_SOURCE_DIR) / name;
   if (std::filesystem::exists(in_source)) return in_source;
 #endif
-  throw CommandError(2, "no policy: " + name.string() + " not found; give one with --policy FILE");
+  throw CommandError(ExitCode::usage, "no policy: " + name.string() + " not found; give one with --policy FILE");
 }
 
 }  // namespace tensegrity::cli

@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/exit_code.hpp"
 #include "firmware/app/config.hpp"
 #include "hil/endcap_config.hpp"
 #include "hil/hil_error.hpp"
@@ -115,7 +116,7 @@ void ProcessLauncher::spawn(int e, bool restart) {
   if (pid == 0) {
     // Child: only async-signal-safe calls until exec.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(127);  // the launcher died before prctl
+    if (::getppid() != parent) ::_exit(exit_status(ExitCode::cannot_exec));  // the launcher died before prctl
     ::setpgid(0, 0);
     // A restart is spawned by the stepper's thread, which runs SCHED_FIFO: the
     // program must not inherit that (its start-up, DDS participant included, would
@@ -130,7 +131,7 @@ void ProcessLauncher::spawn(int e, bool restart) {
     // launcher's own life.
     ::close_range(3, ~0U, 0);
     ::execv(argv[0], argv.data());
-    ::_exit(127);
+    ::_exit(exit_status(ExitCode::cannot_exec));
   }
   ::setpgid(pid, pid);  // also from here: no race with an early kill(-pid)
   ::close(log_fd);

@@ -26,6 +26,11 @@ constexpr double kMaxStrutMassKg = 1000.0;
 constexpr double kMaxStrutRadiusM = 1.0;
 // SUPERball's stand-ins are 0.005-0.5 N m s; 1e307 made ODE abort mid-step (fuzzing).
 constexpr double kMaxAxialDampingNms = 100.0;
+// Steeper than 45 degrees, a robot of friction 1 slides whatever it does.
+constexpr double kMaxSlopeDeg = 45.0;
+constexpr double kMinBumpSpacingM = 0.1;
+constexpr double kMaxBumpSpacingM = 100.0;
+constexpr std::uint64_t kMaxSeed = (std::uint64_t{1} << 53) - 1;
 
 int node_index(const Reader& r, const json& v, const std::string& path, int node_count) {
   if (!v.is_number_integer()) r.fail_at(path, "must be a node index (integer)");
@@ -151,6 +156,35 @@ void parse_cables(const Reader& r, const std::vector<int>& strut_of, Robot& robo
   }
 }
 
+// Optional: without them the ground is the plane z = 0, as every robot file before.
+void parse_terrain(const Reader& ground, Robot& robot) {
+  ground.only({"friction", "restitution", "contact_stiffness_n_per_m", "contact_damping_n_s_per_m", "slope_deg",
+               "slope_azimuth_deg", "rough"});
+  robot.ground_slope_deg = ground.non_negative("slope_deg", 0.0);
+  if (robot.ground_slope_deg > kMaxSlopeDeg) ground.fail("slope_deg", "must be at most 45 degrees");
+  robot.ground_slope_azimuth_deg = ground.number("slope_azimuth_deg", 0.0);
+  if (std::abs(robot.ground_slope_azimuth_deg) > 360.0) {
+    ground.fail("slope_azimuth_deg", "must be within +-360 degrees");
+  }
+  if (!ground.has("rough")) return;
+  const Reader rough = ground.object("rough");
+  rough.only({"bump_height_m", "bump_spacing_m", "seed"});
+  auto& r = robot.ground_rough;
+  r.bump_spacing_m = rough.positive("bump_spacing_m", 0.0, true);
+  if (r.bump_spacing_m < kMinBumpSpacingM || r.bump_spacing_m > kMaxBumpSpacingM) {
+    rough.fail("bump_spacing_m", "must be within [0.1, 100] m");
+  }
+  r.bump_height_m = rough.non_negative("bump_height_m");
+  // Steeper bumps would break the contact's tangent-plane approximation
+  // (sim/model/terrain.hpp): at half the spacing the steepest flank is 37 degrees.
+  if (r.bump_height_m > 0.5 * r.bump_spacing_m) rough.fail("bump_height_m", "must be at most half of bump_spacing_m");
+  r.seed = rough.count("seed");
+  if (r.seed > kMaxSeed) rough.fail("seed", "must be below 2^53 (exact in JSON)");
+  if (robot.engine == Robot::PhysicsEngine::bullet && r.bump_height_m > 0.0) {
+    ground.fail("rough", "the bullet engine has no rough ground (a slope it has); use \"engine\": \"ode\"");
+  }
+}
+
 void parse_ground_and_start(const Reader& r, Robot& robot) {
   const Reader ground = r.object("ground");
   robot.ground_friction = ground.non_negative("friction");
@@ -158,6 +192,7 @@ void parse_ground_and_start(const Reader& r, Robot& robot) {
   if (robot.ground_restitution > 1.0) ground.fail("restitution", "must be within [0, 1]");
   robot.contact_stiffness_n_per_m = ground.positive("contact_stiffness_n_per_m", 0.0, true);
   robot.contact_damping_n_s_per_m = ground.non_negative("contact_damping_n_s_per_m");
+  parse_terrain(ground, robot);
   const Reader start = r.object("start");
   robot.start_clearance_m = start.non_negative("clearance_m");
   robot.settle_s = start.non_negative("settle_s");

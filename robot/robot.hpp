@@ -3,6 +3,7 @@
 // The robot description: geometry, masses, cables and their owners, actuator limits,
 // ground and start. Loaded from JSON (robots/*.json) and validated field by field.
 #include <Eigen/Core>
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -80,6 +81,20 @@ struct Robot {
   double ground_restitution = 0.0;
   double contact_stiffness_n_per_m = 5e5;
   double contact_damping_n_s_per_m = 2e3;
+  // ground.slope_deg, ground.slope_azimuth_deg: the ground is a plane tilted this far,
+  // falling toward the azimuth (from +x toward +y). The model keeps the ground at z = 0
+  // and tilts gravity instead, so x and y are along the slope (docs/design/model.md).
+  double ground_slope_deg = 0.0;
+  double ground_slope_azimuth_deg = 0.0;
+  // ground.rough: bumps on the ground, heights drawn from `seed` at the nodes of a
+  // square grid of bump_spacing_m, within [0, bump_height_m] (sim/model/terrain.hpp).
+  // bump_height_m 0 (absent): flat.
+  struct RoughGround {
+    double bump_height_m = 0.0;
+    double bump_spacing_m = 0.0;
+    std::uint64_t seed = 0;
+  };
+  RoughGround ground_rough;
   // Start: the lowest end cap's surface this far above the ground, then settle.
   double start_clearance_m = 0.05;
   double settle_s = 4.0;

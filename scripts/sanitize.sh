@@ -6,9 +6,12 @@
 #   tsan  ThreadSanitizer on the threads that share memory: the control loop's
 #         mailbox, the end cap's DDS node (end caps in comms_test_node processes
 #         against ground participants) and the HIL's UDP hub
-#   ci    what CI runs (scripts/test.sh), about 6-8 minutes on 2 cores: asan on the
+#   ci    what CI runs (scripts/test.sh), about 9-11 minutes on 2 cores: asan on the
 #         firmware's unit tests (core, drivers, hal, app with its end-cap process
-#         tests, mailbox, comms), tsan on the mailbox and the HIL's unit tests (hub)
+#         tests, mailbox, comms) and on the host's readers of outside input that run
+#         without a simulator (robot and policy files, DDS types and QoS, keystore,
+#         the ground's checks, the view's data and HTTP server), tsan on the mailbox
+#         and the HIL's unit tests (hub)
 # Usage: scripts/sanitize.sh [asan] [tsan] [ci]   (default: asan tsan)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -26,12 +29,13 @@ run_asan() {
 }
 
 firmware='format_tests|core_tests|test_drivers|test_hal|endcap_app_tests|mailbox_tests|comms_tests'
+host='robot_tests|msgs_tests|ground_keystore_tests|ground_start_check_tests|view_test|view_server_test'
 
 run_ci() {
   cmake --preset asan >/dev/null
   cmake --build --preset asan -j "$jobs" --target format_tests core_tests test_drivers test_hal endcap_app_tests mailbox_tests \
-    comms_tests
-  ctest --preset asan -L "^($firmware)\$"
+    comms_tests robot_tests msgs_tests ground_keystore_tests ground_start_check_tests view_test view_server_test
+  ctest --preset asan -L "^($firmware|$host)\$"
   cmake --preset tsan >/dev/null
   cmake --build --preset tsan -j "$jobs" --target mailbox_tests hil_unit_tests
   ctest --preset tsan -L '^(mailbox_tests|hil_unit_tests)$'

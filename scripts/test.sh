@@ -39,8 +39,9 @@ echo "test: host $preset build and tests took $(( $(date +%s) - start )) s"
 fuzz_start=$(date +%s)
 FUZZ_RUNS=5000 scripts/fuzz.sh
 echo "test: fuzzing took $(( $(date +%s) - fuzz_start )) s"
-# ASan + UBSan on the firmware's unit tests, TSan on the loop's mailbox and the HIL's hub (the subset
-# that fits CI's time; scripts/sanitize.sh asan tsan runs the wider sets).
+# ASan + UBSan on the firmware's unit tests and the host's readers of outside input,
+# TSan on the loop's mailbox and the HIL's hub (the subset that fits CI's time;
+# scripts/sanitize.sh asan tsan runs the wider sets).
 san_start=$(date +%s)
 scripts/sanitize.sh ci
 echo "test: sanitizers took $(( $(date +%s) - san_start )) s"

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/exit_code.hpp"
 #include "firmware/endcap/endcap.hpp"
 #include "firmware/endcap/endcap_log.hpp"
 
@@ -130,7 +131,11 @@ int main(int argc, char** argv) {
       "SIGRTMIN+1 mutes the DDS participant of the moment (it hears, nothing it sends arrives; a rejoin clears it)");
   cli.add_flag("--hang-loop-signal", hang_signal,
                "fault injection (HIL tests only): SIGRTMIN hangs the control loop for good, the process lives on");
-  CLI11_PARSE(cli, argc, argv);
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return exit_status(tensegrity::parse_exit(cli.exit(e)));
+  }
   install_fault_hooks(cut_signals, hang_signal, o);  // first thing: a SIGUSR1 before its handler ends the program
   o.config_path = config_path;
   o.keystore = keystore;
@@ -143,12 +148,12 @@ int main(int argc, char** argv) {
     endcap.activate();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "endcap: %s\n", e.what());
-    return 2;
+    return exit_status(tensegrity::ExitCode::usage);  // nothing started: the config, storage or bus refused
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   endcap.run(g_stop);
   endcap.deactivate();
   report_exit(endcap, stats_path);
-  return 0;
+  return exit_status(tensegrity::ExitCode::ok);
 }

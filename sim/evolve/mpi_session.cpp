@@ -63,18 +63,18 @@ MpiSession::~MpiSession() {
       stop_others(10.0);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "tensegrity: rank 0: %s; aborting the MPI job\n", e.what());
-      abort(4);
+      abort(ExitCode::mpi);
     }
   }
   MPI_Finalize();
 }
 
-void MpiSession::abort(int exit_code) {
+void MpiSession::abort(ExitCode code) {
   std::fflush(stdout);
   std::fflush(stderr);
-  MPI_Abort(MPI_COMM_WORLD, exit_code);
+  MPI_Abort(MPI_COMM_WORLD, exit_status(code));
   // MPI_Abort does not return; should an implementation do so anyway, leave.
-  std::_Exit(exit_code);
+  std::_Exit(exit_status(code));
 }
 
 void MpiSession::send(int to, wire::Tag tag, const wire::Bytes& bytes, double timeout_s) {

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/exit_code.hpp"
 #include "sim/evolve/mpi_wire.hpp"
 
 namespace tensegrity::sim::evolve {
@@ -37,7 +38,7 @@ class MpiSession {
   const std::string& host() const { return host_; }
 
   // MPI_Abort: mpirun ends every process of the job. Print the reason first.
-  [[noreturn]] void abort(int exit_code);
+  [[noreturn]] void abort(ExitCode code);
 
   // Returns when `bytes` may be reused (the message is on its way). Throws
   // MpiFailure on an MPI error or after `timeout_s` (<= 0: no limit).

@@ -56,7 +56,8 @@ class Engine {
   virtual void set_body(int strut, const BodyState& state) = 0;
   // Velocities only: the pose stays exactly as the engine holds it.
   virtual void set_velocity(int strut, const Eigen::Vector3d& v_m_per_s, const Eigen::Vector3d& w_rad_per_s) = 0;
-  virtual void set_gravity(double g_m_per_s2) = 0;
+  // In the ground's frame (sim/model/terrain.hpp: a slope tilts it).
+  virtual void set_gravity(const Eigen::Vector3d& g_m_per_s2) = 0;
   // Applied in the next step only.
   virtual void add_force_torque(int strut, const Eigen::Vector3d& force_n, const Eigen::Vector3d& torque_n_m) = 0;
   virtual ContactReport step(double dt_s, const StepInput& input) = 0;

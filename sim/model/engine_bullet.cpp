@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "sim/model/engine.hpp"
+#include "sim/model/terrain.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -25,14 +26,23 @@ Eigen::Vector3d eigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 // at about zero distance, within its contact threshold rather than inside the plane.
 constexpr double kGroundTouchM = 1e-3;
 
+// A slope is gravity tilted, which this engine takes as it is; bumps would need a
+// height field shape here, which it does not have (robot.cpp refuses the file).
+const Robot& checked(const Robot& robot) {
+  if (Terrain(robot).rough()) {
+    throw RobotError(robot.name + ": ground.rough: the bullet engine has no rough ground (a slope it has)");
+  }
+  return robot;
+}
+
 class BulletEngine final : public Engine {
  public:
   BulletEngine(const Robot& robot, double /*dt_s*/)
-      : robot_(robot),
+      : robot_(checked(robot)),
         dispatcher_(&config_),
         world_(&dispatcher_, &broadphase_, &solver_, &config_),
         plane_(btVector3(0, 0, 1), 0) {
-    world_.setGravity(btVector3(0, 0, static_cast<btScalar>(-robot.gravity_m_per_s2)));
+    world_.setGravity(bt(Terrain(robot).gravity_m_per_s2(robot.gravity_m_per_s2)));
     btRigidBody::btRigidBodyConstructionInfo ground_info(0, nullptr, &plane_);
     ground_ = std::make_unique<btRigidBody>(ground_info);
     // Bullet multiplies the two bodies' coefficients: the ground carries 1, the
@@ -100,7 +110,7 @@ class BulletEngine final : public Engine {
     bodies_[strut]->setAngularVelocity(bt(w));
   }
 
-  void set_gravity(double g) override { world_.setGravity(btVector3(0, 0, static_cast<btScalar>(-g))); }
+  void set_gravity(const Eigen::Vector3d& g) override { world_.setGravity(bt(g)); }
 
   void add_force_torque(int strut, const Eigen::Vector3d& f, const Eigen::Vector3d& t) override {
     bodies_[strut]->applyCentralForce(bt(f));

@@ -12,6 +12,7 @@
 
 #include "sim/model/engine.hpp"
 #include "sim/model/model.hpp"
+#include "sim/model/terrain.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -68,7 +69,7 @@ void hold_stepper(dThreadingImplementationID stepper) {
 
 class OdeEngine final : public Engine {
  public:
-  OdeEngine(const Robot& robot, double dt_s) : robot_(robot) {
+  OdeEngine(const Robot& robot, double dt_s) : robot_(robot), terrain_(robot) {
     init_ode_for_this_thread();
     world_ = dWorldCreate();
     // ODE's default stepping "threading" implementation is one process-wide object
@@ -135,7 +136,7 @@ class OdeEngine final : public Engine {
     dBodySetAngularVel(bodies_[strut], w.x(), w.y(), w.z());
   }
 
-  void set_gravity(double g) override { dWorldSetGravity(world_, 0, 0, -g); }
+  void set_gravity(const Eigen::Vector3d& g) override { dWorldSetGravity(world_, g.x(), g.y(), g.z()); }
 
   void add_force_torque(int strut, const Eigen::Vector3d& f, const Eigen::Vector3d& t) override {
     dBodyAddForce(bodies_[strut], f.x(), f.y(), f.z());
@@ -170,8 +171,9 @@ class OdeEngine final : public Engine {
     return contact;
   }
 
-  // A capsule meets a plane only with its end spheres, so two sphere tests per strut
-  // replace ODE's broad phase (which is also not thread-safe in Debian's build).
+  // A capsule meets the ground only with its end spheres (the ground's bumps are far
+  // wider than a strut is thick), so two sphere tests per strut replace ODE's broad
+  // phase and colliders (which are also not thread-safe in Debian's build).
   void add_ground_contacts(const StepInput& in, ContactReport& report) {
     const double r = robot_.strut_radius_m;
     dContact contact = soft_contact();
@@ -179,15 +181,14 @@ class OdeEngine final : public Engine {
       contact.surface.mode |= dContactBounce;
       contact.surface.bounce = robot_.ground_restitution;
     }
-    contact.geom.normal[2] = 1;
+    GroundContact touch;
     for (std::size_t node = 0; node < in.node_pos_m.size(); ++node) {
-      const Eigen::Vector3d& p = in.node_pos_m[node];
-      const double depth = r - p.z();
-      if (depth <= 0.0) continue;
-      contact.geom.pos[0] = p.x();
-      contact.geom.pos[1] = p.y();
-      contact.geom.pos[2] = p.z() - r;
-      contact.geom.depth = depth;
+      if (!terrain_.touches(in.node_pos_m[node], r, touch)) continue;
+      for (int k = 0; k < 3; ++k) {
+        contact.geom.pos[k] = touch.point_m[k];
+        contact.geom.normal[k] = touch.normal[k];
+      }
+      contact.geom.depth = touch.depth_m;
       dJointID joint = dJointCreateContact(world_, contacts_, &contact);
       dJointAttach(joint, bodies_[in.strut_of_node[node]], nullptr);
       ++report.ground_contacts;
@@ -215,6 +216,7 @@ class OdeEngine final : public Engine {
   }
 
   const Robot& robot_;
+  Terrain terrain_;
   dWorldID world_ = nullptr;
   dJointGroupID contacts_ = nullptr;
   dThreadingImplementationID threading_ = nullptr;

@@ -58,7 +58,8 @@ ModelState dropped(const Robot& robot, double dt_s, std::vector<Eigen::Vector3d>
   Model model(robot, resolve_dt(robot, dt_s));
   double lowest = nodes.front().z();
   for (const auto& p : nodes) lowest = std::min(lowest, p.z());
-  const double lift = robot.start_clearance_m + robot.strut_radius_m - lowest;
+  // Above the highest bump of rough ground (0 on a plane).
+  const double lift = robot.start_clearance_m + robot.strut_radius_m - lowest + Terrain(robot).max_height_m();
   for (auto& p : nodes) p.z() += lift;
   model.place(nodes);
   return model.save();

@@ -15,7 +15,7 @@ std::unique_ptr<Engine> make_engine(const Robot& robot, double dt_s) {
   return robot.engine == Robot::PhysicsEngine::bullet ? make_bullet_engine(robot, dt_s) : make_ode_engine(robot, dt_s);
 }
 
-Model::Model(const Robot& robot, double dt_s) : robot_(robot), dt_s_(dt_s) {
+Model::Model(const Robot& robot, double dt_s) : robot_(robot), terrain_(robot_), dt_s_(dt_s) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) throw RobotError("model: time step must be > 0");
   engine_ = make_engine(robot_, dt_s);
   set_gravity_enabled(true);
@@ -78,7 +78,9 @@ void Model::init_surface_attachments() {
   }
 }
 
-void Model::set_gravity_enabled(bool on) { engine_->set_gravity(on ? robot_.gravity_m_per_s2 : 0.0); }
+void Model::set_gravity_enabled(bool on) {
+  engine_->set_gravity(terrain_.gravity_m_per_s2(on ? robot_.gravity_m_per_s2 : 0.0));
+}
 
 void Model::pull_bodies() {
   for (std::size_t s = 0; s < body_.size(); ++s) body_[s] = engine_->body(static_cast<int>(s));

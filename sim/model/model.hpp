@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sim/model/engine.hpp"
+#include "sim/model/terrain.hpp"
 #include "robot/robot.hpp"
 
 namespace tensegrity::sim {
@@ -64,7 +65,7 @@ class Model {
   std::vector<Eigen::Vector3d> node_positions() const;
   Eigen::Vector3d centre_m() const;  // mean of the end caps
   double kinetic_energy_j() const;
-  double gravity_energy_j() const;  // relative to z = 0
+  double gravity_energy_j() const;  // relative to z = 0, in the tilted gravity of a slope
   double elastic_energy_j() const;
   // Strut spin about its own axis, rad/s.
   double axial_spin_rad_per_s(int strut) const;
@@ -108,6 +109,7 @@ class Model {
   bool forces_sane() const;
 
   Robot robot_;
+  Terrain terrain_;  // the slope's gravity; the engine makes the ground's contacts
   double dt_s_;
   std::unique_ptr<Engine> engine_;
   std::vector<BodyState> body_;  // per strut, as the engine last reported it

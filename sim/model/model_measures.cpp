@@ -38,6 +38,12 @@ double Model::kinetic_energy_j() const {
 
 double Model::gravity_energy_j() const {
   double e = 0.0;
+  if (robot_.ground_slope_deg != 0.0) {
+    // On a slope gravity is tilted in the ground's frame: the energy is -m g . p.
+    const Eigen::Vector3d g = terrain_.gravity_m_per_s2(robot_.gravity_m_per_s2);
+    for (const BodyState& body : body_) e -= robot_.strut_mass_kg * g.dot(body.position_m);
+    return e;
+  }
   for (const BodyState& body : body_) e += robot_.strut_mass_kg * robot_.gravity_m_per_s2 * body.position_m.z();
   return e;
 }

@@ -2,21 +2,14 @@
 #pragma once
 // Per-step telemetry of an episode, on request: a sink sees the model after each
 // recorded step.
-#include <fstream>
+#include <memory>
 #include <string>
-#include <string_view>
+
+#include "sim/model/run_record.hpp"
 
 namespace tensegrity::sim {
 
 class Model;
-
-// A run record (`sim --telemetry`, `hil --record`) names one cable's quantity
-// cableM_QUANTITY: cable_column(3, "tension_n") is "cable3_tension_n". Both writers
-// use it, so the view and the tools read either record by the same names.
-std::string cable_column(int cable, std::string_view quantity);
-// The name HIL records of older versions used, QUANTITY_M ("tension_n_3"): readers
-// accept it too, so a record made then stays readable.
-std::string legacy_cable_column(int cable, std::string_view quantity);
 
 class TelemetrySink {
  public:
@@ -26,9 +19,9 @@ class TelemetrySink {
   virtual void end() {}
 };
 
-// One CSV row per recorded step: time; every node's position; per cable rest
-// length, length, tension and motor power (tension x rest-length rate); kinetic,
-// gravitational and elastic energy.
+// `sim --telemetry`: the episode as a run record (sim/model/run_record.hpp), one row
+// per recorded step. The file is created at construction, so a bad path fails before
+// the episode runs.
 class CsvTelemetry final : public TelemetrySink {
  public:
   explicit CsvTelemetry(const std::string& path);
@@ -38,7 +31,7 @@ class CsvTelemetry final : public TelemetrySink {
 
  private:
   std::string path_;
-  std::ofstream out_;
+  std::unique_ptr<RunRecordWriter> writer_;
 };
 
 }  // namespace tensegrity::sim

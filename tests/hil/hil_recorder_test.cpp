@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// `hil --record` and `sim --telemetry` write one run-record scheme: every column the
-// HIL names is named the same in the simulator's record (the HIL adds only the
-// centre), so the view and tools/ read both by the same names.
+// `hil --record` and `sim --telemetry` write one run-record schema
+// (sim/model/run_record.hpp), so the view and tools/ read both by the same names.
 #include "hil/recorder.hpp"
 
 #include <gtest/gtest.h>
@@ -9,55 +8,108 @@
 
 #include <filesystem>
 #include <fstream>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "hil/hil_error.hpp"
 #include "robot/robot.hpp"
 #include "sim/model/telemetry.hpp"
 
 namespace tensegrity::hil {
 namespace {
 
-std::vector<std::string> header_of(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::string line, cell;
-  std::getline(in, line);
+std::vector<std::string> cells_of(const std::string& line) {
   std::vector<std::string> out;
+  std::string cell;
   std::stringstream cells(line);
   while (std::getline(cells, cell, ',')) out.push_back(cell);
   return out;
 }
 
-TEST(HilRecorder, NamesEveryColumnAsTheSimulatorsRecordDoes) {
+std::vector<std::string> lines_of(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::filesystem::path temp_csv(const std::string& name) {
+  return std::filesystem::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".csv");
+}
+
+TEST(HilRecorder, WritesTheSimulatorsRunRecordSchema) {
   const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
   const sim::Model model(robot, robot.time_step_s);
-  const auto dir = std::filesystem::temp_directory_path();
-  const auto hil_path = dir / ("hil_recorder_test_" + std::to_string(::getpid()) + ".csv");
-  const auto sim_path = dir / ("hil_recorder_test_sim_" + std::to_string(::getpid()) + ".csv");
+  const auto hil_path = temp_csv("hil_recorder_test");
+  const auto sim_path = temp_csv("hil_recorder_test_sim");
   {
     Recorder recorder(hil_path, model);
     recorder.record(0.0, model);
     recorder.close();
     sim::CsvTelemetry telemetry(sim_path.string());
     telemetry.begin(model);
+    telemetry.record(0.0, model);
     telemetry.end();
   }
-  const auto hil = header_of(hil_path);
-  const auto sim_header = header_of(sim_path);
+  const auto hil = lines_of(hil_path);
+  const auto sim_lines = lines_of(sim_path);
   std::filesystem::remove(hil_path);
   std::filesystem::remove(sim_path);
-  const std::set<std::string> sim_names(sim_header.begin(), sim_header.end());
-  ASSERT_EQ(hil.size(), 4U + 24U * 2U + 12U * 3U + 3U);
-  for (const auto& name : hil) {
-    if (name.rfind("centre_", 0) == 0) continue;
-    EXPECT_TRUE(sim_names.count(name)) << name << " is not a column of `sim --telemetry`";
-  }
-  EXPECT_EQ(hil[4 + 3], "cable3_rest_length_m");
-  EXPECT_EQ(hil[4 + 24 + 3], "cable3_tension_n");
-  EXPECT_EQ(sim::cable_column(3, "tension_n"), "cable3_tension_n");
+  ASSERT_EQ(hil.size(), 2U);
+  EXPECT_EQ(hil, sim_lines);
+  const auto header = cells_of(hil[0]);
+  ASSERT_EQ(header.size(), 1U + 3U + 12U * 3U + 24U * 4U + 3U);
+  EXPECT_EQ(header[1], "centre_x_m");
+  EXPECT_EQ(header[4], "node0_x_m");
+  EXPECT_EQ(header[40 + 3], "cable3_rest_length_m");
+  EXPECT_EQ(header[40 + 2 * 24 + 3], "cable3_tension_n");
+  EXPECT_EQ(header.back(), "elastic_energy_j");
   EXPECT_EQ(sim::legacy_cable_column(3, "tension_n"), "tension_n_3");
+}
+
+TEST(HilRecorder, ARowHoldsEveryColumnAndTheCentreIsTheEndCapsMean) {
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
+  const sim::Model model(robot, robot.time_step_s);
+  const auto path = temp_csv("hil_recorder_row");
+  {
+    Recorder recorder(path, model);
+    recorder.record(1.25, model);
+    recorder.close();
+  }
+  const auto lines = lines_of(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(lines.size(), 2U);
+  const auto header = cells_of(lines[0]);
+  const auto row = cells_of(lines[1]);
+  ASSERT_EQ(row.size(), header.size());
+  EXPECT_EQ(std::stod(row[0]), 1.25);
+  for (int k = 0; k < 3; ++k) {
+    double sum = 0.0;
+    for (int i = 0; i < 12; ++i) sum += std::stod(row[4 + 3 * i + k]);
+    EXPECT_NEAR(std::stod(row[1 + k]), sum / 12.0, 1e-8) << header[1 + k];
+    EXPECT_NEAR(std::stod(row[1 + k]), model.centre_m()[k], 1e-8) << header[1 + k];
+  }
+}
+
+TEST(HilRecorder, AFullDiskIsAnErrorNamingTheFile) {
+  if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
+  const sim::Model model(robot, robot.time_step_s);
+  Recorder recorder("/dev/full", model);
+  for (int i = 0; i < 100; ++i) recorder.record(i * 0.001, model);
+  try {
+    recorder.close();
+    FAIL() << "a record on a full disk closed without an error";
+  } catch (const HilError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/full"), std::string::npos) << e.what();
+  }
+}
+
+TEST(HilRecorder, AFileThatCannotBeCreatedIsAnErrorNamingIt) {
+  const sim::Robot robot = sim::load_robot(sim::robot_path_named("superball"));
+  const sim::Model model(robot, robot.time_step_s);
+  EXPECT_THROW(Recorder("/nonexistent-dir/run.csv", model), HilError);
 }
 
 }  // namespace

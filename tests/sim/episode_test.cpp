@@ -160,7 +160,8 @@ TEST(Episode, TelemetryCsvHasOneRowPerRecordedStep) {
   int rows = 0;
   while (std::getline(in, line)) ++rows;
   EXPECT_EQ(rows, 100);
-  EXPECT_EQ(std::count(header.begin(), header.end(), ','), 12 * 3 + 24 * 4 + 3);
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','),
+            3 + 12 * 3 + 24 * 4 + 3);  // after time_s: centre, nodes, cables, energies
   EXPECT_NE(header.find("cable13_tension_n"), std::string::npos);
   EXPECT_NE(header.find("cable23_power_w"), std::string::npos);
   std::remove(path.c_str());

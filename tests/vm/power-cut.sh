@@ -81,13 +81,7 @@ ird="$work/root"
 vm_initramfs_root "$ird" "$work/kernel"
 mkdir -p "$ird/mnt"
 strip -o "$ird/guest" "$guest" 2>/dev/null || cp "$guest" "$ird/guest"
-cat >"$ird/init" <<'EOF'
-#!/bin/busybox sh
-/bin/busybox --install -s /bin
-export PATH=/bin:/sbin
-mount -t proc proc /proc
-mount -t sysfs sysfs /sys
-mount -t devtmpfs devtmpfs /dev 2>/dev/null
+vm_write_init "$ird" <<'EOF'
 for m in $(cat /modules/order); do insmod "/modules/$m" || echo "PC INSMODFAILED $m"; done
 for w in $(cat /proc/cmdline); do
   case "$w" in pc.mode=*) mode=${w#*=} ;; pc.break=*) brk=${w#*=} ;; pc.mount=*) opts=${w#*=} ;; esac
@@ -106,7 +100,6 @@ else
 fi
 poweroff -f
 EOF
-chmod +x "$ird/init"
 vm_pack_initramfs "$ird" "$work/initrd.gz"
 
 # no_timer_check: on a loaded host TCG's timer sometimes misses the kernel's IO-APIC

@@ -61,13 +61,7 @@ vm_initramfs_root "$ird" "$work/kernel"
 strip -o "$ird/test" "$binary" 2>/dev/null || cp "$binary" "$ird/test"
 printf '%s\n' "${test_args[@]+"${test_args[@]}"}" >"$ird/test.args"
 
-cat >"$ird/init" <<'EOF'
-#!/bin/busybox sh
-/bin/busybox --install -s /bin
-export PATH=/bin:/sbin
-mount -t proc proc /proc
-mount -t sysfs sysfs /sys
-mount -t devtmpfs devtmpfs /dev 2>/dev/null
+vm_write_init "$ird" <<'EOF'
 mount -t tmpfs tmpfs /tmp
 ok=1
 for m in $(cat /modules/order); do
@@ -89,7 +83,6 @@ echo "TENSEGRITY-VM-RESULT rc=$rc"
 sync
 poweroff -f
 EOF
-chmod +x "$ird/init"
 vm_pack_initramfs "$ird" "$work/initrd.gz"
 
 # --- boot -----------------------------------------------------------------------------

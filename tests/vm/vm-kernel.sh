@@ -10,6 +10,8 @@
 #                                        modules (dependencies first) to DEST/modules,
 #                                        sets VM_KERNEL (its ABI) and VM_ORDER (their paths)
 #   vm_initramfs_root DIR DEST           busybox, /modules/*.ko and /modules/order in DIR
+#   vm_write_init DIR <BODY              DIR/init: busybox's shell with /proc, /sys and
+#                                        /dev mounted, then the test's BODY from stdin
 #   vm_pack_initramfs DIR OUT            DIR as a gzip'd newc cpio archive
 # The cache keeps only the modules some test asked for (about 400 MB otherwise);
 # asking for one it lacks downloads the package again and keeps the union. A test
@@ -148,6 +150,21 @@ vm_initramfs_root() {
   mkdir -p "$ird"/{bin,sbin,usr/bin,usr/sbin,proc,sys,dev,tmp}
   cp /bin/busybox "$ird/bin/busybox"
   cp -r "$dest/modules" "$ird/modules"
+}
+
+vm_write_init() {
+  {
+    cat <<'EOF'
+#!/bin/busybox sh
+/bin/busybox --install -s /bin
+export PATH=/bin:/sbin
+mount -t proc proc /proc
+mount -t sysfs sysfs /sys
+mount -t devtmpfs devtmpfs /dev 2>/dev/null
+EOF
+    cat
+  } >"$1/init"
+  chmod +x "$1/init"
 }
 
 vm_pack_initramfs() {

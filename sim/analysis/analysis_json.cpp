@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "cli/analysis_json.hpp"
+#include "sim/analysis/analysis_json.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
-namespace tensegrity::cli {
+namespace tensegrity::sim::analysis {
 namespace {
 
 namespace an = sim::analysis;
@@ -127,32 +126,4 @@ json analysis_json(const an::EpisodeSeries& series, const an::Analysis& a, const
   return j;
 }
 
-void print_analysis_summary(const json& j) {
-  const auto& m = j["rest_length_m"];
-  const auto& p = j["power_per_muscle_w"];
-  const auto& r = j["rolling"];
-  const auto& period = j["revolution_period_s"];
-  std::printf("  window           %.1f-%.1f s (%zu samples)\n", j["window_s"][0].get<double>(),
-              j["window_s"][1].get<double>(), j["samples"].get<std::size_t>());
-  std::printf("  rest lengths     %.3f-%.3f m, means %.3f-%.3f m\n", m["min"].get<double>(), m["max"].get<double>(),
-              m["mean_lowest"].get<double>(), m["mean_highest"].get<double>());
-  std::printf("  tension          mean %.1f N, peak %.1f N\n", j["tension_n"]["mean"].get<double>(),
-              j["tension_n"]["peak"].get<double>());
-  std::printf("  power per muscle mean %.2f W (muscles %.2f-%.2f W; 1 s mean %.2f-%.2f W)\n", p["mean"].get<double>(),
-              p["lowest_muscle"].get<double>(), p["highest_muscle"].get<double>(), p["mean_over_1s_min"].get<double>(),
-              p["mean_over_1s_max"].get<double>());
-  const auto& from = r["face_cycle_from_s"];
-  std::printf(
-      "  revolution       %.2f s from contacts, %.2f s from faces (%d per cycle, from %.1f s), %.2f s from "
-      "rotation\n",
-      period["contacts"].get<double>(), period["faces"].get<double>(), r["faces_per_cycle"].get<int>(),
-      from.is_null() ? 0.0 : from.get<double>(), period["rotation"].get<double>());
-  std::printf("  rolling          %.2f revolutions, %d of %d end caps touched, %zu faces, slip median %.3f m/s\n",
-              r["revolutions"].get<double>(), r["endcaps_touched_count"].get<int>(), j["endcaps"].get<int>(),
-              r["face_sequence"].size(), r["slip_m_per_s"]["median"].get<double>());
-  std::printf("  clusters         %zu (zero lag), %zu (phase aligned) at 1 - r <= %.2f\n",
-              j["clusters"]["zero_lag"].size(), j["clusters"]["phase_aligned"].size(),
-              j["clusters"]["cut_height"].get<double>());
-}
-
-}  // namespace tensegrity::cli
+}  // namespace tensegrity::sim::analysis

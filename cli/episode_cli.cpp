@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "cli/episode_json.hpp"
+#include "cli/episode_cli.hpp"
 
 #include <cstdio>
 #include <string>
@@ -12,32 +12,6 @@ namespace tensegrity::cli {
 sim::Robot load_robot_arg(const std::string& path, const std::string& policy) {
   if (!path.empty()) return sim::load_robot(path);
   return sim::load_robot(policy.empty() ? sim::default_robot_path() : sim::robot_path_for_policy(policy));
-}
-
-nlohmann::json episode_json(const sim::EpisodeResult& r) {
-  return {
-      {"distance_m", r.distance_m},
-      {"displacement_m", {r.displacement_m.x(), r.displacement_m.y()}},
-      {"displacement_start_m", {r.travel.start_m.x(), r.travel.start_m.y()}},
-      {"heading_deg", r.travel.heading_deg ? nlohmann::json(*r.travel.heading_deg) : nlohmann::json(nullptr)},
-      {"start_frame", {{"yaw_deg", r.travel.yaw_deg}, {"face", r.start_face}}},
-      {"feasible", r.feasible},
-      {"infeasible_reason", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_reason)},
-      {"infeasible_time_s", r.feasible ? nlohmann::json(nullptr) : nlohmann::json(r.infeasible_time_s)},
-      {"max_tension_n", r.max_tension_n},
-      {"mean_tension_n", r.mean_tension_n},
-      {"motor_energy_j", r.motor_energy_j},
-      {"mean_motor_power_w", r.mean_motor_power_w},
-      {"axial_spin_rms_rad_per_s", r.axial_spin_rms_rad_per_s},
-      {"axial_spin_max_rad_per_s", r.axial_spin_max_rad_per_s},
-      {"endcaps_touched_ground", r.endcaps_touched_ground},
-      {"min_strut_gap_m", r.min_strut_gap_m},
-      {"strut_overlap_s", r.strut_overlap_s},
-      {"steps", r.steps},
-      {"sim_time_s", r.sim_time_s},
-      {"wall_time_s", r.wall_time_s},
-      {"real_time_factor", r.real_time_factor()},
-  };
 }
 
 void print_heading(const sim::Travel& t, const std::vector<int>& face) {

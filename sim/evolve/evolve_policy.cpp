@@ -1,15 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "cli/evolve_policy.hpp"
+#include "sim/evolve/evolve_policy.hpp"
 
 #include "sim/model/core_controller.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
 
-namespace tensegrity::cli {
+namespace tensegrity::sim::evolve {
 
-sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig& config,
-                        const sim::evolve::Coevolution& evo, double score_m) {
-  sim::Policy policy = sim::evolve::team_policy(robot, config.period_s, config.complexity, evo.best().team);
-  policy.provenance.method = sim::evolve::to_string(config.method);
+Policy best_policy(const Robot& robot, const EvolveConfig& config, const Coevolution& evo, double score_m) {
+  Policy policy = team_policy(robot, config.period_s, config.complexity, evo.best().team);
+  policy.provenance.method = to_string(config.method);
   policy.provenance.seed = config.seed;
   policy.provenance.episodes = evo.episodes();
   policy.provenance.score_m = score_m;
@@ -17,7 +16,7 @@ sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig
   policy.provenance.population = config.population;
   policy.provenance.replace = config.replace;
   policy.provenance.teams = config.teams;
-  policy.provenance.mutation = sim::evolve::to_string(config.mutation);
+  policy.provenance.mutation = to_string(config.mutation);
   policy.provenance.sigma_m = config.sigma_m;
   policy.provenance.sigma_final_m = config.anneal_episodes > 0 ? config.sigma_final_m : config.sigma_m;
   policy.provenance.anneal_episodes = config.anneal_episodes;
@@ -25,11 +24,11 @@ sim::Policy best_policy(const sim::Robot& robot, const sim::evolve::EvolveConfig
   return policy;
 }
 
-sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveConfig& config, sim::Policy& policy) {
-  sim::CoreController controller(robot, policy);
-  sim::EpisodeOptions episode;
+EpisodeResult play_gait(const Robot& robot, const EvolveConfig& config, Policy& policy) {
+  CoreController controller(robot, policy);
+  EpisodeOptions episode;
   episode.duration_s = config.duration_s;
-  const sim::EpisodeResult gait = sim::run_episode(robot, controller, episode);
+  const EpisodeResult gait = run_episode(robot, controller, episode);
   policy.provenance.axial_spin_rms_rad_per_s = gait.axial_spin_rms_rad_per_s;
   policy.provenance.axial_spin_max_rad_per_s = gait.axial_spin_max_rad_per_s;
   policy.provenance.endcaps_touched_ground = gait.endcaps_touched_ground;
@@ -40,4 +39,4 @@ sim::EpisodeResult play_gait(const sim::Robot& robot, const sim::evolve::EvolveC
   return gait;
 }
 
-}  // namespace tensegrity::cli
+}  // namespace tensegrity::sim::evolve
