@@ -31,6 +31,8 @@ void add_bench_command(CLI::App& app);
 void add_evolve_command(CLI::App& app);
 // `gaits symmetries|transform|set`: the symmetry group's gaits (sim/symmetry.hpp).
 void add_gaits_command(CLI::App& app);
+// `drive`: steer a course of waypoints (ground/drive/).
+void add_drive_command(CLI::App& app);
 // `bench evolve`, added by add_bench_command.
 void add_bench_evolve_command(CLI::App& bench);
 // Ground tools over DDS (ground/): one file each.

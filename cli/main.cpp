@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   tensegrity::cli::add_bench_command(app);
   tensegrity::cli::add_evolve_command(app);
   tensegrity::cli::add_gaits_command(app);
+  tensegrity::cli::add_drive_command(app);
 #ifdef TENSEGRITY_CLI_DDS
   tensegrity::cli::add_upload_command(app);
   tensegrity::cli::add_start_command(app);
