@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/episode_cli.hpp"
 #include "sim/model/episode_json.hpp"
 #include "robot/perturbation_set.hpp"
 #include "robot/policy.hpp"
