@@ -38,7 +38,8 @@ std::filesystem::path set_path(const std::string& given) {
   const std::filesystem::path in_source = std::filesystem::path(TENSEGRITY_SOURCE_DIR) / kDefaultSet;
   if (std::filesystem::exists(in_source)) return in_source;
 #endif
-  throw CommandError(ExitCode::usage, std::string("robustness: no perturbation set: ") + kDefaultSet + " not found; give --set FILE");
+  throw CommandError(ExitCode::usage,
+                     std::string("robustness: no perturbation set: ") + kDefaultSet + " not found; give --set FILE");
 }
 
 nlohmann::json case_json(const sim::RobustnessCase& c) {
