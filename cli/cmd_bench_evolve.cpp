@@ -17,6 +17,7 @@
 #include "sim/evolve/curve_csv.hpp"
 #include "sim/evolve/driver.hpp"
 #include "sim/evolve/episode_evaluator.hpp"
+#include "sim/evolve/randomized_evaluator.hpp"
 
 namespace tensegrity::cli {
 namespace {
@@ -26,9 +27,23 @@ struct BenchEvolveArgs {
   std::int64_t episodes = 100;
   int threads = 0;
   double duration_s = 60.0;
-  double dt_s = 0.0;  // 0: what `tensegrity evolve` scores at by default
+  double dt_s = 0.0;      // 0: what `tensegrity evolve` scores at by default
+  std::string randomize;  // robust learning's file; empty: the robot's own model
+  int randomize_k = 8;
   bool json = false;
 };
+
+// As `tensegrity evolve --randomize FILE --randomize-k K` sets it.
+void set_randomization(sim::evolve::EvolveConfig& config, const BenchEvolveArgs& args, const sim::Robot& robot) {
+  if (args.randomize.empty()) return;
+  try {
+    config.randomization = sim::load_randomization(args.randomize).canonical;
+    config.randomize_k = args.randomize_k;
+    (void)sim::evolve::config_randomization(config, robot);
+  } catch (const std::runtime_error& e) {
+    throw CommandError(ExitCode::usage, std::string("--randomize: ") + e.what());
+  }
+}
 
 // The targets: 5000 episodes in at most 3 minutes on the machine's cores.
 constexpr double kTargetEpisodes = 5000.0;
@@ -74,6 +89,7 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
   sim::evolve::set_robot(config, robot);
   config.dt_s = args.dt_s > 0.0 ? args.dt_s : sim::evolve::default_learning_dt_s(robot);
   sim::evolve::set_default_early_end(config, robot);
+  set_randomization(config, args, robot);
   const double dt_s = config.dt_s > 0.0 ? config.dt_s : robot.time_step_s;
   // The settled start is computed once per process; keep it out of the timing.
   (void)sim::settled_state(robot, dt_s);
@@ -91,6 +107,7 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
                         {"dt_s", dt_s},
                         {"early_end_bar_m", config.early_end_bar_m},
                         {"threads", threads},
+                        {"randomize_k", config.randomization.empty() ? 0 : config.randomize_k},
                         {"wall_s", many.wall_s},
                         {"episodes_per_s", many.episodes_per_s},
                         {"episodes_per_s_per_core", per_core},
@@ -109,6 +126,10 @@ void run_bench_evolve(const BenchEvolveArgs& args) {
   } else {
     std::printf("bench evolve: %lld episodes of %.0f s at dt %.4g s (teams of 50, historical), %d threads\n",
                 static_cast<long long>(args.episodes), args.duration_s, dt_s, threads);
+    if (!config.randomization.empty()) {
+      std::printf("  every team on %d sampled models (%s): %d physics episodes per team\n", config.randomize_k,
+                  args.randomize.c_str(), config.randomize_k);
+    }
     std::printf("  %.2f episodes/s, %.2f per core, %.1f s wall\n", many.episodes_per_s, per_core, many.wall_s);
     std::printf("  5000 episodes would take %.0f s; target %.0f s, ratio %.2f\n", projected_s, kTarget5000EpisodesWallS,
                 kTarget5000EpisodesWallS / projected_s);
@@ -138,6 +159,14 @@ void add_bench_evolve_command(CLI::App& bench) {
   cmd->add_option("--dt", args->dt_s,
                   "Time step teams are scored at, seconds (default: as `tensegrity evolve`, the robot's learning step)")
       ->check(CLI::Range(1e-5, 0.01));
+  CLI::Option* file = cmd->add_option("--randomize", args->randomize,
+                                      "Score every team on sampled models from this randomization file, as "
+                                      "`tensegrity evolve --randomize`")
+                          ->check(CLI::ExistingFile);
+  cmd->add_option("--randomize-k", args->randomize_k, "With --randomize: sampled models per team")
+      ->capture_default_str()
+      ->check(CLI::Range(1, sim::evolve::kMaxRandomizeK))
+      ->needs(file);
   cmd->add_flag("--json", args->json, "Print one JSON object");
   cmd->callback([args] { run_bench_evolve(*args); });
 }

@@ -128,6 +128,12 @@ void print_text(const EvolveArgs& args, const sim::evolve::EvolveConfig& config,
     std::printf("  scored at dt %.4g s; at the robot's own step it rolls %.3f m%s (the policy's score)\n", config.dt_s,
                 o.gait.distance_m, o.gait.feasible ? "" : " INFEASIBLE");
   }
+  if (!config.randomization.empty()) {
+    std::printf(
+        "  models     %d sampled per team from %s, new every generation; score %s (re-evaluated on "
+        "the next generation's)\n",
+        config.randomize_k, args.request.randomize.c_str(), sim::evolve::to_string(config.randomize_score));
+  }
   std::printf("  infeasible %.0f%% in the last generation\n", 100.0 * infeasible_last);
   std::printf("  gait       strut spin %.2f rad/s RMS, %.2f max; %d end caps touched the ground\n",
               o.gait.axial_spin_rms_rad_per_s, o.gait.axial_spin_max_rad_per_s, o.gait.endcaps_touched_ground);
@@ -232,6 +238,23 @@ void add_mpi_options(CLI::App& cmd, EvolveArgs& args) {
       ->check(CLI::Range(0.0, 1e7));
 }
 
+// Robust learning: teams scored on sampled models.
+void add_randomize_options(CLI::App& cmd, EvolveArgs& args) {
+  CLI::Option* file = cmd.add_option("--randomize", args.request.randomize,
+                                     "Score every team on sampled models drawn from this randomization file "
+                                     "(tensegrity-randomization/1; new samples every generation, the same for "
+                                     "every team of one)");
+  cmd.add_option("--randomize-k", args.request.randomize_k, "With --randomize: sampled models per team")
+      ->capture_default_str()
+      ->check(CLI::Range(1, sim::evolve::kMaxRandomizeK))
+      ->needs(file);
+  cmd.add_option("--randomize-score", args.request.randomize_score,
+                 "With --randomize: a team's score from its samples' distances: mean, or q25 (the lower quartile)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mean", "q25"}))
+      ->needs(file);
+}
+
 }  // namespace
 
 void add_evolve_command(CLI::App& app) {
@@ -286,9 +309,15 @@ void add_evolve_command(CLI::App& app) {
   cmd->add_option("--log", args->log, "Learning curve CSV")->required();
   cmd->add_flag("--json", args->json, "Print a JSON summary");
   add_mpi_options(*cmd, *args);
+  add_randomize_options(*cmd, *args);
   cmd->callback([args] {
     if (args->resume && args->checkpoint.empty())
       throw CommandError(ExitCode::usage, "--resume needs --checkpoint DIR");
+    if (args->mpi && !args->request.randomize.empty()) {
+      throw CommandError(ExitCode::usage,
+                         "--randomize is not sent to MPI ranks (they would score the robot's own model): run it "
+                         "without --mpi, on --threads");
+    }
     check_evolve_launch(args->mpi);
     if (!args->mpi) {
       run_evolve(*args, nullptr);

@@ -179,6 +179,7 @@ const GenerationStats& Coevolution::step(Evaluator& evaluator) {
   std::vector<Team> teams;
   teams.reserve(picks.size());
   for (const auto& p : picks) teams.push_back(team(p));
+  evaluator.set_generation(state_.generation + 1);
   const std::vector<TeamResult> results = evaluator.evaluate(teams);
   GenerationStats stats = record(picks, teams, results);
   select_and_breed();

@@ -38,6 +38,14 @@ Mutation parse_mutation(const std::string& text) {
   throw ConfigError("unknown mutation '" + text + "' (author or gaussian)");
 }
 
+const char* to_string(SampleScore score) { return score == SampleScore::q25 ? "q25" : "mean"; }
+
+SampleScore parse_sample_score(const std::string& text) {
+  if (text == "mean") return SampleScore::mean;
+  if (text == "q25") return SampleScore::q25;
+  throw ConfigError("unknown sample score '" + text + "' (mean or q25)");
+}
+
 void validate(const EvolveConfig& c) {
   auto fail = [](const std::string& what) { throw ConfigError("evolve config: " + what); };
   if (c.population < 2) fail("population must be at least 2");
@@ -66,6 +74,9 @@ void validate(const EvolveConfig& c) {
   if (!(c.early_end_bar_m >= 0.0 && c.early_end_bar_m <= 1000.0)) fail("early_end_bar_m must be in [0, 1000]");
   if (c.early_end_bar_m > 0.0 && !(c.early_end_speed_m_per_s > 0.0 && c.early_end_speed_m_per_s <= 100.0)) {
     fail("early_end_speed_m_per_s must be in (0, 100] when early_end_bar_m is set");
+  }
+  if (!c.randomization.empty() && (c.randomize_k < 1 || c.randomize_k > kMaxRandomizeK)) {
+    fail("randomize_k must be in 1.." + std::to_string(kMaxRandomizeK));
   }
 }
 
@@ -105,6 +116,10 @@ nlohmann::json config_to_json(const EvolveConfig& c) {
     j["early_end_bar_m"] = c.early_end_bar_m;
     j["early_end_speed_m_per_s"] = c.early_end_speed_m_per_s;
   }
+  if (!c.randomization.empty()) {
+    j["randomization"] = {
+        {"set", nlohmann::json::parse(c.randomization)}, {"k", c.randomize_k}, {"score", to_string(c.randomize_score)}};
+  }
   return j;
 }
 
@@ -135,6 +150,12 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     c.early_end_speed_m_per_s = j.value("early_end_speed_m_per_s", 0.0);
     c.robot_name = j.at("robot_name").get<std::string>();
     c.robot_hash = j.at("robot_hash").get<std::string>();
+    if (j.contains("randomization")) {
+      const nlohmann::json& r = j.at("randomization");
+      c.randomization = r.at("set").dump();
+      c.randomize_k = r.at("k").get<int>();
+      c.randomize_score = parse_sample_score(r.at("score").get<std::string>());
+    }
     return c;
   } catch (const nlohmann::json::exception& e) {
     throw ConfigError(std::string("evolve config: ") + e.what());

@@ -60,6 +60,17 @@ struct StepSchedule {
 // mean best 32.2 m, 8 of 10 seeds at 37-39 m).
 inline constexpr StepSchedule kDefaultGaussianSchedule{0.05, 0.02, 2000, 3000};
 
+// How a team's scores on its sampled models (robust learning) become its score.
+enum class SampleScore {
+  mean,  // the mean over the samples
+  q25,   // the lower quartile (linear between order statistics): what it rolls on a bad model
+};
+
+const char* to_string(SampleScore score);
+SampleScore parse_sample_score(const std::string& text);
+// At most this many sampled models per team: each costs a whole episode.
+inline constexpr int kMaxRandomizeK = 64;
+
 struct EvolveConfig {
   FitnessMethod method = FitnessMethod::historical;
   // 40 members, 20 replaced: the author's Config.ini has 10 and 5, which on this
@@ -97,6 +108,13 @@ struct EvolveConfig {
   double early_end_speed_m_per_s = 0.0;
   std::string robot_name;
   std::string robot_hash;
+  // Robust learning: every team is scored on randomize_k models drawn afresh each
+  // generation from these ranges (the canonical text of a randomization file,
+  // robot/randomization.hpp), its scores combined by randomize_score. Empty: the
+  // robot's own model alone.
+  std::string randomization;
+  int randomize_k = 1;
+  SampleScore randomize_score = SampleScore::mean;
 };
 
 // The mutation step for copies bred after `episodes_done` episodes.

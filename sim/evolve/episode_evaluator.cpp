@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "sim/evolve/randomized_evaluator.hpp"
 #include "sim/model/core_controller.hpp"
 
 namespace tensegrity::sim::evolve {
@@ -24,6 +25,11 @@ TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, do
                          const Team& team, const EarlyEnd& early_end) {
   const Policy policy = team_policy(robot, period_s, complexity, team);
   CoreController controller(robot, policy);
+  return score_episode(robot, controller, duration_s, dt_s, early_end);
+}
+
+TeamResult score_episode(const Robot& robot, Controller& controller, double duration_s, double dt_s,
+                         const EarlyEnd& early_end) {
   EpisodeOptions options;
   options.duration_s = duration_s;
   options.dt_s = dt_s;
@@ -58,6 +64,13 @@ double default_learning_dt_s(const Robot& robot) {
 }
 
 TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config) {
+  // A team's score on randomized models depends on the generation, which a function
+  // of the team alone (threads, MPI ranks) does not know.
+  if (!config.randomization.empty()) {
+    throw ConfigError(
+        "randomized models (--randomize) are scored on this process's threads only, not sent to MPI "
+        "ranks: run without --mpi");
+  }
   if (robot.cable_count() != config.cables) {
     throw ConfigError("robot has " + std::to_string(robot.cable_count()) + " cables, config " +
                       std::to_string(config.cables));
@@ -75,6 +88,7 @@ TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& confi
 }
 
 std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads) {
+  if (!config.randomization.empty()) return std::make_unique<RandomizedEvaluator>(robot, config, threads);
   return std::make_unique<ParallelEvaluator>(episode_team_function(robot, config), threads);
 }
 

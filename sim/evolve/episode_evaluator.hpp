@@ -35,6 +35,11 @@ void set_default_early_end(EvolveConfig& config, const Robot& robot);
 TeamResult evaluate_team(const Robot& robot, double period_s, int complexity, double duration_s, double dt_s,
                          const Team& team, const EarlyEnd& early_end = {});
 
+// One episode of `controller` (made for `robot`) from the settled start, scored as
+// evaluate_team scores it. Thread-safe for distinct controllers.
+TeamResult score_episode(const Robot& robot, Controller& controller, double duration_s, double dt_s,
+                         const EarlyEnd& early_end);
+
 // What an episode ended early scores: its distance so far scaled to the whole
 // duration (a steady gait's own score), at most the bar it provably cannot reach.
 double early_end_score_m(const EpisodeResult& result, double duration_s, double bar_m);
@@ -44,7 +49,8 @@ double early_end_score_m(const EpisodeResult& result, double duration_s, double 
 // config. Every evaluator of episodes (threads, MPI ranks) scores with this.
 TeamFunction episode_team_function(const Robot& robot, const EvolveConfig& config);
 
-// The episode scorer on `threads` workers (each worker runs whole episodes).
+// The episode scorer on `threads` workers (each worker runs whole episodes); with a
+// randomization in the config, a RandomizedEvaluator (randomized_evaluator.hpp).
 std::unique_ptr<Evaluator> make_episode_evaluator(const Robot& robot, const EvolveConfig& config, int threads);
 
 }  // namespace tensegrity::sim::evolve

@@ -17,6 +17,10 @@ Robot parse_checked(const EpisodeSetup& setup) {
 }  // namespace
 
 EpisodeSetup episode_setup(const std::string& robot_json, const EvolveConfig& config) {
+  // The setup carries no randomization: ranks would score the robot's own model.
+  if (!config.randomization.empty()) {
+    throw ConfigError("randomized models (--randomize) are not sent to MPI ranks: run without --mpi");
+  }
   EpisodeSetup setup{robot_json,      config.robot_hash,      config.cables,
                      config.period_s, config.complexity,      config.duration_s,
                      config.dt_s,     config.early_end_bar_m, config.early_end_speed_m_per_s};

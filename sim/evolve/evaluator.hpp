@@ -30,6 +30,10 @@ class Evaluator {
   // results[i] belongs to teams[i]. Must depend on teams[i] alone (not on the batch,
   // the order or the thread), or runs stop being reproducible.
   virtual std::vector<TeamResult> evaluate(std::span<const Team> teams) = 0;
+  // The generation (1 for the first) whose teams the next batches are. An evaluator
+  // whose models change every generation (randomized models) draws them for it; every
+  // team of a generation then meets the same models. The others ignore it.
+  virtual void set_generation(int /*generation*/) {}
 };
 
 using TeamFunction = std::function<TeamResult(const Team&)>;

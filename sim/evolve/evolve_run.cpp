@@ -7,6 +7,7 @@
 
 #include "sim/evolve/episode_evaluator.hpp"
 #include "sim/evolve/evolve_policy.hpp"
+#include "sim/evolve/randomized_evaluator.hpp"
 
 namespace tensegrity::sim::evolve {
 namespace {
@@ -32,6 +33,19 @@ void set_step_schedule(EvolveConfig& config, const EvolveRequest& r) {
   config.sigma_final_m = r.sigma_final_m < 0.0 ? config.sigma_m : r.sigma_final_m;
   config.anneal_episodes = std::max<std::int64_t>(r.anneal_episodes, 0);
   config.anneal_start_episodes = std::max<std::int64_t>(r.anneal_start_episodes, 0);
+}
+
+// Robust learning's file and rule, checked against the robot.
+void set_randomization(EvolveConfig& config, const EvolveRequest& r, const Robot& robot) {
+  if (r.randomize.empty()) return;
+  try {
+    config.randomization = load_randomization(r.randomize).canonical;
+  } catch (const RandomizationError& e) {
+    throw ConfigError(std::string("--randomize: ") + e.what());
+  }
+  config.randomize_k = r.randomize_k;
+  config.randomize_score = parse_sample_score(r.randomize_score);
+  (void)config_randomization(config, robot);
 }
 
 }  // namespace
@@ -60,6 +74,7 @@ EvolveConfig request_config(const EvolveRequest& r, const Robot& robot) {
     }
     config.early_end_bar_m = r.early_end_m;
   }
+  set_randomization(config, r, robot);
   validate(config);
   return config;
 }
@@ -76,6 +91,7 @@ EvolveOutcome run_evolution(const Robot& robot, const EvolveConfig& config, Eval
   const auto started = std::chrono::steady_clock::now();
   EvolveOutcome o{drive(config, evaluator, options), TeamResult{}, EpisodeResult{}, Policy{}, 0.0};
   const std::vector<Team> final_team{o.result.evolution.best().team};
+  evaluator.set_generation(o.result.evolution.generation() + 1);
   o.final_result = evaluator.evaluate(final_team).front();
   o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   o.policy = best_policy(robot, config, o.result.evolution, o.final_result.score_m);

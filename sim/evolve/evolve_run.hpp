@@ -40,6 +40,10 @@ struct EvolveRequest {
   double duration_s = 60.0;
   double dt_s = 0.0;          // 0: the robot's learning step
   double early_end_m = -1.0;  // negative: the robot's learning.early_end
+  // Robust learning: a randomization file (robot/randomization.hpp); empty: none.
+  std::string randomize;
+  int randomize_k = 8;
+  std::string randomize_score = "mean";
 };
 
 // Throws ConfigError naming the option or the value that does not work.
@@ -54,9 +58,11 @@ struct RunFiles {
 
 struct EvolveOutcome {
   DriverResult result;
-  TeamResult final_result;  // the best team evaluated once more, alone
-  EpisodeResult gait;       // its episode at the robot's own step
-  Policy policy;            // as written to RunFiles::policy
+  // The best team evaluated once more, alone (randomized: on the next generation's
+  // models, which it has not met).
+  TeamResult final_result;
+  EpisodeResult gait;  // its episode at the robot's own step
+  Policy policy;       // as written to RunFiles::policy
   double wall_s = 0.0;
 };
 

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sim/model/episode.hpp"
+#include "sim/model/settled_cache.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -69,12 +70,37 @@ ModelState dropped(const Robot& robot, double dt_s, std::vector<Eigen::Vector3d>
 
 ModelState drop_state(const Robot& robot, double dt_s) { return dropped(robot, dt_s, robot.nodes_m); }
 
+namespace {
+
+struct SettledCache {
+  std::mutex mutex;
+  std::map<std::pair<std::string, double>, std::unique_ptr<ModelState>> states;
+};
+
+SettledCache& settled_cache() {
+  static SettledCache cache;
+  return cache;
+}
+
+}  // namespace
+
+void forget_settled_state(const Robot& robot, double dt_s) {
+  SettledCache& cache = settled_cache();
+  const std::lock_guard lock(cache.mutex);
+  cache.states.erase({robot.hash + robot.name, resolve_dt(robot, dt_s)});
+}
+
+std::size_t settled_states_cached() {
+  SettledCache& cache = settled_cache();
+  const std::lock_guard lock(cache.mutex);
+  return cache.states.size();
+}
+
 const ModelState& settled_state(const Robot& robot, double dt_s) {
   dt_s = resolve_dt(robot, dt_s);
-  static std::mutex mutex;
-  static std::map<std::pair<std::string, double>, std::unique_ptr<ModelState>> cache;
-  const std::lock_guard lock(mutex);
-  auto& slot = cache[{robot.hash + robot.name, dt_s}];
+  SettledCache& cache = settled_cache();
+  const std::lock_guard lock(cache.mutex);
+  auto& slot = cache.states[{robot.hash + robot.name, dt_s}];
   if (!slot) {
     Model model(robot, dt_s);
     const bool face_down = robot.start_pose == Robot::StartPose::face_down;
