@@ -7,6 +7,7 @@
 #include <system_error>
 
 #include "format/atomic_file.hpp"
+#include "sim/evolve/json_integer.hpp"
 
 namespace tensegrity::sim::evolve {
 namespace {
@@ -21,10 +22,10 @@ nlohmann::json stats_to_json(const GenerationStats& s) {
 
 GenerationStats stats_from_json(const nlohmann::json& j) {
   GenerationStats s;
-  s.generation = j.at("generation").get<int>();
-  s.episodes = j.at("episodes").get<std::int64_t>();
-  s.teams = j.at("teams").get<int>();
-  s.infeasible = j.at("infeasible").get<int>();
+  s.generation = json_integer<int>(j, "generation");
+  s.episodes = json_integer<std::int64_t>(j, "episodes");
+  s.teams = json_integer<int>(j, "teams");
+  s.infeasible = json_integer<int>(j, "infeasible");
   s.best_score_m = j.at("best_score_m").get<double>();
   s.mean_score_m = j.at("mean_score_m").get<double>();
   s.best_so_far_m = j.at("best_so_far_m").get<double>();
@@ -73,9 +74,9 @@ Checkpoint parse_checkpoint(const std::string& text, const std::string& source) 
     Checkpoint cp;
     cp.config = config_from_json(j.at("config"));
     CoevolutionState& s = cp.state;
-    s.generation = j.at("generation").get<int>();
-    s.episodes = j.at("episodes").get<std::int64_t>();
-    s.infeasible_episodes = j.at("infeasible_episodes").get<std::int64_t>();
+    s.generation = json_integer<int>(j, "generation");
+    s.episodes = json_integer<std::int64_t>(j, "episodes");
+    s.infeasible_episodes = json_integer<std::int64_t>(j, "infeasible_episodes");
     s.rng_state = j.at("rng_state").get<std::string>();
     for (const auto& population : j.at("populations")) {
       auto& members = s.populations.emplace_back();
@@ -91,8 +92,8 @@ Checkpoint parse_checkpoint(const std::string& text, const std::string& source) 
       s.best.team.rest_lengths_m = best.at("rest_lengths_m").get<std::vector<std::vector<double>>>();
       s.best.score_m = best.at("score_m").get<double>();
       s.best.feasible = best.at("feasible").get<bool>();
-      s.best.episode = best.at("episode").get<std::int64_t>();
-      s.best.generation = best.at("generation").get<int>();
+      s.best.episode = json_integer<std::int64_t>(best, "episode", "best.episode");
+      s.best.generation = json_integer<int>(best, "generation", "best.generation");
     }
     // Shape, limits and the engine state are checked the way a resume will use them.
     (void)Coevolution(cp.config, s);

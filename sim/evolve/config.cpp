@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/limits.hpp"
+#include "sim/evolve/json_integer.hpp"
 
 namespace tensegrity::sim::evolve {
 
@@ -127,20 +128,20 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
   try {
     EvolveConfig c;
     c.method = parse_fitness_method(j.at("method").get<std::string>());
-    c.population = j.at("population").get<int>();
-    c.teams = j.at("teams").get<int>();
-    c.replace = j.at("replace").get<int>();
+    c.population = json_integer<int>(j, "population");
+    c.teams = json_integer<int>(j, "teams");
+    c.replace = json_integer<int>(j, "replace");
     // Checkpoints from before the author's operator existed mutated every value.
     c.mutation = parse_mutation(j.value("mutation", std::string("gaussian")));
     c.sigma_m = j.at("sigma_m").get<double>();
     // Checkpoints from before annealing existed mutated with sigma_m throughout.
     c.sigma_final_m = j.value("sigma_final_m", c.sigma_m);
-    c.anneal_episodes = j.value("anneal_episodes", std::int64_t{0});
-    c.anneal_start_episodes = j.value("anneal_start_episodes", std::int64_t{0});
-    c.seed = j.at("seed").get<std::uint64_t>();
-    c.episodes = j.at("episodes").get<std::int64_t>();
-    c.cables = j.at("cables").get<int>();
-    c.complexity = j.at("complexity").get<int>();
+    c.anneal_episodes = json_integer_or<std::int64_t>(j, "anneal_episodes", 0);
+    c.anneal_start_episodes = json_integer_or<std::int64_t>(j, "anneal_start_episodes", 0);
+    c.seed = json_integer<std::uint64_t>(j, "seed");
+    c.episodes = json_integer<std::int64_t>(j, "episodes");
+    c.cables = json_integer<int>(j, "cables");
+    c.complexity = json_integer<int>(j, "complexity");
     c.min_rest_length_m = j.at("min_rest_length_m").get<double>();
     c.max_rest_length_m = j.at("max_rest_length_m").get<double>();
     c.period_s = j.at("period_s").get<double>();
@@ -153,7 +154,7 @@ EvolveConfig config_from_json(const nlohmann::json& j) {
     if (j.contains("randomization")) {
       const nlohmann::json& r = j.at("randomization");
       c.randomization = r.at("set").dump();
-      c.randomize_k = r.at("k").get<int>();
+      c.randomize_k = json_integer<int>(r, "k");
       c.randomize_score = parse_sample_score(r.at("score").get<std::string>());
     }
     return c;

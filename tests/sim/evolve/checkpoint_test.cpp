@@ -207,6 +207,30 @@ TEST_F(Checkpoints, AnInconsistentCheckpointIsRejected) {
   EXPECT_NO_THROW((void)parse_checkpoint(text, "x"));
 }
 
+// An integer field holding a float, a number beyond its type or a string is refused
+// naming the field; get<int>() would have cast a double of 4e57 to int (undefined
+// behaviour, found by fuzz_evolve_checkpoint).
+TEST_F(Checkpoints, AnIntegerFieldOutOfItsRangeOrNotAnIntegerIsNamed) {
+  run_generations(root_ / "b", 2);
+  const std::string text = read(root_ / "b" / "ckpt" / kCheckpointFile);
+  const auto error_of = [&](const std::function<void(nlohmann::json&)>& edit) -> std::string {
+    nlohmann::json j = nlohmann::json::parse(text);
+    edit(j);
+    try {
+      (void)parse_checkpoint(j.dump(), "x");
+    } catch (const CheckpointError& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_NE(error_of([](auto& j) { j["config"]["complexity"] = 4.4e57; }).find("complexity"), std::string::npos);
+  EXPECT_NE(error_of([](auto& j) { j["config"]["cables"] = 4294967300LL; }).find("cables"), std::string::npos);
+  EXPECT_NE(error_of([](auto& j) { j["config"]["seed"] = -1; }).find("seed"), std::string::npos);
+  EXPECT_NE(error_of([](auto& j) { j["config"]["anneal_episodes"] = 1.5; }).find("anneal_episodes"), std::string::npos);
+  EXPECT_NE(error_of([](auto& j) { j["generation"] = "2"; }).find("generation"), std::string::npos);
+  EXPECT_NE(error_of([](auto& j) { j["curve"][0]["teams"] = 1e300; }).find("teams"), std::string::npos);
+}
+
 // Checkpoints written before the mutation step could anneal have no schedule: they
 // mutated with sigma_m throughout, and they resume that way.
 TEST_F(Checkpoints, OneWithoutAMutationScheduleResumesWithAConstantStep) {
