@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "robot/robot.hpp"
+#include "tests/robot/robot_json.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -16,21 +17,9 @@ namespace {
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-json paper_json() {
-  std::ifstream in(robot_path_named("superball-paper"));
-  std::stringstream s;
-  s << in.rdbuf();
-  return json::parse(s.str());
-}
+json paper_json() { return test_files::shipped_robot_json("superball-paper"); }
 
-std::string error_of(const json& doc) {
-  try {
-    parse_robot(doc.dump(), "test.json");
-  } catch (const RobotError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const json& doc) { return test_files::robot_error_of(doc); }
 
 TEST(GroundFields, AbsentMeansTheLevelPlaneAndTheSameHash) {
   const json doc = paper_json();

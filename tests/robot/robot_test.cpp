@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "robot/robot.hpp"
+#include "tests/robot/robot_json.hpp"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -14,21 +15,9 @@ namespace {
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-json superball_json() {
-  std::ifstream in(robot_path_named("superball"));
-  std::stringstream s;
-  s << in.rdbuf();
-  return json::parse(s.str());
-}
+json superball_json() { return test_files::shipped_robot_json("superball"); }
 
-std::string error_of(const json& doc) {
-  try {
-    parse_robot(doc.dump(), "test.json");
-  } catch (const RobotError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const json& doc) { return test_files::robot_error_of(doc); }
 
 TEST(Robot, ShippedSuperballLoads) {
   const Robot robot = load_robot(robot_path_named("superball"));

@@ -15,6 +15,7 @@
 #include "sim/evolve/episode_evaluator.hpp"
 #include "robot/policy.hpp"
 #include "robot/robot.hpp"
+#include "tests/robot/robot_json.hpp"
 
 namespace tensegrity::sim {
 namespace {
@@ -22,21 +23,9 @@ namespace {
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-json robot_json(const std::string& name) {
-  std::ifstream in(robot_path_named(name));
-  std::stringstream s;
-  s << in.rdbuf();
-  return json::parse(s.str());
-}
+json robot_json(const std::string& name) { return test_files::shipped_robot_json(name); }
 
-std::string error_of(const json& doc) {
-  try {
-    parse_robot(doc.dump(), "test.json");
-  } catch (const RobotError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const json& doc) { return test_files::robot_error_of(doc); }
 
 TEST(Learning, AbsentTheRobotLearnsAtItsOwnStepAndRunsEveryEpisodeToItsEnd) {
   json doc = robot_json("superball");
