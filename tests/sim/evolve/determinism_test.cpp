@@ -10,20 +10,14 @@
 #include "robot/robot.hpp"
 #include "tests/sim/evolve/synthetic.hpp"
 
+#include "tests/sim/evolve/run_outcome.hpp"
+
 namespace tensegrity::sim::evolve {
 namespace {
 
-struct Outcome {
-  std::string curve;
-  std::string state;
-  BestTeam best;
-};
+using Outcome = testing::RunOutcome;
 
-Outcome run(const EvolveConfig& config, Evaluator& evaluator) {
-  auto result = drive(config, evaluator, {});
-  return Outcome{curve_csv(result.evolution.curve()), checkpoint_to_json(config, result.evolution.state()),
-                 result.evolution.best()};
-}
+Outcome run(const EvolveConfig& config, Evaluator& evaluator) { return testing::run_outcome(config, evaluator); }
 
 void expect_same(const Outcome& a, const Outcome& b) {
   EXPECT_EQ(a.curve, b.curve);

@@ -20,6 +20,8 @@
 #include "robot/robot.hpp"
 #include "tests/sim/evolve/synthetic.hpp"
 
+#include "tests/sim/evolve/run_outcome.hpp"
+
 namespace tensegrity::sim::evolve {
 namespace {
 
@@ -37,15 +39,9 @@ TeamFunction factory(const wire::Setup& setup) {
   return episode_team_function(episode_setup_from_wire(setup));
 }
 
-struct Outcome {
-  std::string curve;
-  std::string state;
-};
+using Outcome = testing::RunOutcome;
 
-Outcome run(const EvolveConfig& config, Evaluator& evaluator) {
-  auto result = drive(config, evaluator, {});
-  return Outcome{curve_csv(result.evolution.curve()), checkpoint_to_json(config, result.evolution.state())};
-}
+Outcome run(const EvolveConfig& config, Evaluator& evaluator) { return testing::run_outcome(config, evaluator); }
 
 int failures = 0;
 

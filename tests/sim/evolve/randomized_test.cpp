@@ -18,6 +18,8 @@
 #include "sim/model/episode.hpp"
 #include "sim/model/settled_cache.hpp"
 
+#include "tests/sim/evolve/run_outcome.hpp"
+
 namespace tensegrity::sim::evolve {
 namespace {
 
@@ -53,15 +55,9 @@ EvolveConfig randomized(EvolveConfig config, int k, bool delay = true) {
   return config;
 }
 
-struct Outcome {
-  std::string curve;
-  std::string state;
-};
+using Outcome = testing::RunOutcome;
 
-Outcome run(const EvolveConfig& config, Evaluator& evaluator) {
-  auto result = drive(config, evaluator, {});
-  return Outcome{curve_csv(result.evolution.curve()), checkpoint_to_json(config, result.evolution.state())};
-}
+Outcome run(const EvolveConfig& config, Evaluator& evaluator) { return testing::run_outcome(config, evaluator); }
 
 const Robot& robot() {
   static const Robot r = load_robot(robot_path_named("superball-paper"));
