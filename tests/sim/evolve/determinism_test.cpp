@@ -43,16 +43,7 @@ TEST(Determinism, SyntheticFitnessIsTheSameOnOneTwoAndThreeThreads) {
 
 TEST(Determinism, PhysicsIsTheSameOnOneTwoAndThreeThreads) {
   const Robot robot = load_robot(robot_path_named("superball"));
-  EvolveConfig config;
-  config.teams = 4;
-  config.episodes = 8;  // 2 generations
-  config.population = 4;
-  config.replace = 2;
-  config.complexity = 3;
-  config.period_s = 1.0;
-  config.duration_s = 2.0;
-  config.seed = 5;
-  set_robot(config, robot);
+  const EvolveConfig config = testing::short_physics_config(robot);
   std::vector<Outcome> outcomes;
   for (int threads : {1, 2, 3}) {
     auto evaluator = make_episode_evaluator(robot, config, threads);

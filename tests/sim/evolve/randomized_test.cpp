@@ -31,21 +31,6 @@ std::string ranges_text(json ranges) {
   return parse_randomization(json{{"format", kRandomizationFormat}, {"ranges", std::move(ranges)}}.dump()).canonical;
 }
 
-// Two generations of four teams, 2 s episodes: a run in seconds.
-EvolveConfig short_config(const Robot& robot) {
-  EvolveConfig config;
-  config.teams = 4;
-  config.episodes = 8;
-  config.population = 4;
-  config.replace = 2;
-  config.complexity = 3;
-  config.period_s = 1.0;
-  config.duration_s = 2.0;
-  config.seed = 5;
-  set_robot(config, robot);
-  return config;
-}
-
 // With a delay the episodes go through the faulty-hardware controller.
 EvolveConfig randomized(EvolveConfig config, int k, bool delay = true) {
   json ranges = {{"motor_speed_scale", range(0.8, 1.2)}, {"friction_scale", range(0.7, 1.4)}};
@@ -74,7 +59,7 @@ TEST(Randomized, TheScoreRules) {
 }
 
 TEST(Randomized, TheSameSeedIsTheSameRunToTheBitInAnyThreadCount) {
-  const EvolveConfig config = randomized(short_config(robot()), 2);
+  const EvolveConfig config = randomized(testing::short_physics_config(robot()), 2);
   RandomizedEvaluator one(robot(), config, 1);
   RandomizedEvaluator two(robot(), config, 2);
   const Outcome a = run(config, one);
@@ -88,7 +73,7 @@ TEST(Randomized, TheSameSeedIsTheSameRunToTheBitInAnyThreadCount) {
 }
 
 TEST(Randomized, TeamsOfOneGenerationMeetTheSameModelsAndTheNextNewOnes) {
-  const EvolveConfig config = randomized(short_config(robot()), 3, false);
+  const EvolveConfig config = randomized(testing::short_physics_config(robot()), 3, false);
   RandomizedEvaluator evaluator(robot(), config, 2);
   evaluator.set_generation(4);
   std::vector<std::string> hashes;
@@ -119,7 +104,7 @@ TEST(Randomized, TeamsOfOneGenerationMeetTheSameModelsAndTheNextNewOnes) {
 }
 
 TEST(Randomized, OneZeroWidthSampleIsPlainEvolutionToTheBit) {
-  const EvolveConfig plain = short_config(robot());
+  const EvolveConfig plain = testing::short_physics_config(robot());
   EvolveConfig zero = plain;
   zero.randomization = ranges_text({{"motor_speed_scale", range(1, 1)},
                                     {"cable_stiffness_scale", range(1, 1)},
@@ -140,7 +125,7 @@ TEST(Randomized, OneZeroWidthSampleIsPlainEvolutionToTheBit) {
 
 TEST(Randomized, TheCacheHoldsOnlyThisGenerationsSettledStarts) {
   // A seed of its own: models other tests drew (and left cached) are not drawn again.
-  EvolveConfig config = randomized(short_config(robot()), 4);
+  EvolveConfig config = randomized(testing::short_physics_config(robot()), 4);
   config.seed = 99;
   RandomizedEvaluator evaluator(robot(), config, 2);
   Team team;
@@ -158,12 +143,12 @@ TEST(Randomized, TheCacheHoldsOnlyThisGenerationsSettledStarts) {
 }
 
 TEST(Randomized, TheRandomizationIsPartOfTheConfigAndMpiRefusesIt) {
-  const EvolveConfig config = randomized(short_config(robot()), 8);
+  const EvolveConfig config = randomized(testing::short_physics_config(robot()), 8);
   const EvolveConfig back = config_from_json(config_to_json(config));
   EXPECT_EQ(back.randomization, config.randomization);
   EXPECT_EQ(back.randomize_k, 8);
   EXPECT_TRUE(config_differences(config, back).empty());
-  EXPECT_FALSE(config_differences(config, short_config(robot())).empty());
+  EXPECT_FALSE(config_differences(config, testing::short_physics_config(robot())).empty());
   EvolveConfig q25 = config;
   q25.randomize_score = SampleScore::q25;
   EXPECT_FALSE(config_differences(config, q25).empty());
